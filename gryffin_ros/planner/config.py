@@ -1,0 +1,163 @@
+"""Campaign configuration: Gryffin-format dicts/JSON/YAML (`general`, `parameters`, `objectives`) plus `constraints`.
+
+Everything is validated when loaded; an unknown key or a wrong type fails with a message naming it.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+from .errors import ConfigError
+from .space import SearchSpace
+
+TOP_LEVEL_KEYS = {"name", "general", "parameters", "objectives", "constraints", "database"}
+# Gryffin keys we accept for compatibility; they change nothing here (ours has no such knob) and are documented.
+GRYFFIN_NO_OP_KEYS = {"num_cpus", "boosted", "caching", "save_database", "verbosity", "backend", "parallel"}
+
+
+@dataclass(frozen=True)
+class Objective:
+    name: str
+    goal: str  # "min" | "max"
+
+
+@dataclass(frozen=True)
+class GeneralSettings:
+    batches: int = 1
+    sampling_strategies: int = 2
+    num_random_samples: int = 200
+    acquisition_optimizer: str = "adam"
+    obj_transform: str = "sqrt"
+    feasible_fraction: float | None = None
+    random_seed: int | None = None
+    max_rejection_draws: int = 1_000_000
+
+
+_GENERAL_TYPES: dict[str, tuple[type, ...]] = {
+    "batches": (int,), "sampling_strategies": (int,), "num_random_samples": (int,),
+    "acquisition_optimizer": (str,), "obj_transform": (str,), "feasible_fraction": (int, float),
+    "random_seed": (int,), "max_rejection_draws": (int,),
+}
+_GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"}, "obj_transform": {"sqrt", "identity"}}
+
+
+@dataclass
+class PlannerConfig:
+    name: str
+    space: SearchSpace
+    objectives: list[Objective]
+    general: GeneralSettings
+    constraint_specs: list[Any] = field(default_factory=list)
+    raw: dict = field(default_factory=dict)
+
+    @property
+    def hash(self) -> str:
+        """Stable digest of the configuration, to tell whether a stored campaign belongs to this config."""
+        return hashlib.sha256(json.dumps(self.raw, sort_keys=True).encode()).hexdigest()
+
+
+def read_config(source: Mapping | str | Path) -> dict:
+    """A config dict from a mapping or a YAML/JSON file path (a deep copy: the caller's dict is never changed)."""
+    if isinstance(source, Mapping):
+        return copy.deepcopy(dict(source))
+    if not isinstance(source, (str, Path)):
+        raise ConfigError(f"config must be a mapping or a file path, got {type(source).__name__}")
+    path = Path(source)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ConfigError(f"cannot read config file '{path}': {exc.strerror}") from None
+    try:
+        data = json.loads(text) if path.suffix == ".json" else yaml.safe_load(text)
+    except (json.JSONDecodeError, yaml.YAMLError) as exc:
+        raise ConfigError(f"config file '{path}' is not valid {'JSON' if path.suffix == '.json' else 'YAML'}: "
+                          f"{exc}") from None
+    if not isinstance(data, Mapping):
+        raise ConfigError(f"config file '{path}' must hold a mapping at the top level")
+    return dict(data)
+
+
+def _general(spec: Any) -> GeneralSettings:
+    if spec is None:
+        return GeneralSettings()
+    if not isinstance(spec, Mapping):
+        raise ConfigError("'general' must be a mapping")
+    values: dict[str, Any] = {}
+    for key, value in spec.items():
+        if key in GRYFFIN_NO_OP_KEYS:
+            continue
+        if key == "auto_desc_gen":
+            if value not in (False, None):
+                raise ConfigError("general.auto_desc_gen (dynamic descriptors) is not supported yet; set it to false")
+            continue
+        if key not in _GENERAL_TYPES:
+            raise ConfigError(f"unknown key 'general.{key}'; known keys: {sorted(_GENERAL_TYPES)}")
+        if value is None and key in ("feasible_fraction", "random_seed"):
+            continue
+        if isinstance(value, bool) or not isinstance(value, _GENERAL_TYPES[key]):
+            raise ConfigError(f"'general.{key}' has the wrong type: {value!r}")
+        if key in _GENERAL_CHOICES and value not in _GENERAL_CHOICES[key]:
+            raise ConfigError(f"'general.{key}' must be one of {sorted(_GENERAL_CHOICES[key])}, got {value!r}")
+        values[key] = value
+    for key in ("batches", "sampling_strategies", "num_random_samples", "max_rejection_draws"):
+        if key in values and values[key] < 1:
+            raise ConfigError(f"'general.{key}' must be at least 1, got {values[key]}")
+    fraction = values.get("feasible_fraction")
+    if fraction is not None and not (0 < fraction <= 1 and math.isfinite(fraction)):
+        raise ConfigError(f"'general.feasible_fraction' must be in (0, 1], got {fraction}")
+    return GeneralSettings(**values)
+
+
+def _objectives(spec: Any, parameter_names: tuple[str, ...]) -> list[Objective]:
+    if spec is None:
+        spec = [{"name": "obj", "goal": "min"}]
+    if not isinstance(spec, (list, tuple)) or not spec:
+        raise ConfigError("'objectives' must be a non-empty list")
+    out = []
+    for i, item in enumerate(spec):
+        if not isinstance(item, Mapping):
+            raise ConfigError(f"objectives[{i}] must be a mapping")
+        unknown = set(item) - {"name", "goal", "tolerance", "absolute"}
+        if unknown:
+            raise ConfigError(f"objectives[{i}]: unknown key(s) {sorted(unknown)}")
+        name, goal = item.get("name"), item.get("goal", "min")
+        if not isinstance(name, str) or not name:
+            raise ConfigError(f"objectives[{i}]: 'name' must be a non-empty string")
+        if name in parameter_names:
+            raise ConfigError(f"objective '{name}' has the same name as a parameter")
+        if goal not in ("min", "max", "minimize", "maximize"):
+            raise ConfigError(f"objective '{name}': 'goal' must be 'min' or 'max', got {goal!r}")
+        out.append(Objective(name, goal[:3]))
+    if len({o.name for o in out}) != len(out):
+        raise ConfigError("duplicate objective names")
+    if len(out) > 1:
+        raise ConfigError(f"{len(out)} objectives given: multi-objective optimization (Chimera) is not supported yet; "
+                          "give one objective")
+    return out
+
+
+def load_config(source: Mapping | str | Path) -> PlannerConfig:
+    raw = read_config(source)
+    unknown = set(raw) - TOP_LEVEL_KEYS
+    if unknown:
+        raise ConfigError(f"unknown top-level config key(s) {sorted(unknown)}; allowed: {sorted(TOP_LEVEL_KEYS)}")
+    if "parameters" not in raw:
+        raise ConfigError("config has no 'parameters'")
+    space = SearchSpace.from_config(raw["parameters"])
+    objectives = _objectives(raw.get("objectives"), space.names)
+    general = _general(raw.get("general"))
+    constraints = raw.get("constraints") or []
+    if not isinstance(constraints, list):
+        raise ConfigError("'constraints' must be a list")
+    name = raw.get("name", "campaign")
+    if not isinstance(name, str) or not name:
+        raise ConfigError("'name' must be a non-empty string")
+    return PlannerConfig(name, space, objectives, general, constraints, raw)

@@ -1,0 +1,220 @@
+"""Known constraints: callables, declarative expressions and plugins, combined by AND, plus the feasible fraction V_C.
+
+Constraint plugins are factories ``(options: dict) -> constraint`` registered under the entry-point group
+``gryffin_ros.constraints``; the built-ins ``expression`` and ``flow_reactor`` live here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+
+from .errors import ConfigError, ConstraintError, NoFeasiblePointError
+from .expressions import Expression
+from .space import SearchSpace
+
+PLUGIN_GROUP = "gryffin_ros.constraints"
+ENUMERATION_LIMIT = 10**6
+
+
+@dataclass
+class NamedConstraint:
+    """One known constraint. ``columns_fn`` (vectorized over column arrays) is used when present, else ``fn``."""
+
+    name: str
+    fn: Callable[[dict], Any]
+    columns_fn: Callable[[Mapping[str, np.ndarray]], np.ndarray] | None = None
+
+
+def expression_constraint(options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
+    text = options.get("expression") if isinstance(options, Mapping) else None
+    expression = Expression(text, names)
+    return NamedConstraint(text, expression, expression.evaluate)
+
+
+def flow_reactor_constraint(options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
+    """The flow limits of the C60 flow reactor: min_total < F_C + F_S < max_total and each flow below ratio x the other."""
+    allowed = {"min_total", "max_total", "ratio", "c60_flow", "sultine_flow"}
+    unknown = set(options) - allowed
+    if unknown:
+        raise ConfigError(f"flow_reactor constraint: unknown option(s) {sorted(unknown)}; allowed {sorted(allowed)}")
+    fc, fs = options.get("c60_flow", "F_C"), options.get("sultine_flow", "F_S")
+    low, high, ratio = options.get("min_total", 30.0), options.get("max_total", 310.0), options.get("ratio", 2.0)
+    for key, value in (("min_total", low), ("max_total", high), ("ratio", ratio)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ConfigError(f"flow_reactor constraint: '{key}' must be a finite number, got {value!r}")
+    if not low < high:
+        raise ConfigError(f"flow_reactor constraint: min_total ({low}) must be below max_total ({high})")
+    text = f"{low!r} < {fc} + {fs} < {high!r} and {fc} < {ratio!r} * {fs} and {fs} < {ratio!r} * {fc}"
+    expression = Expression(text, names)
+    return NamedConstraint(f"flow_reactor({text})", expression, expression.evaluate)
+
+
+BUILTIN_PLUGINS = {"expression": expression_constraint, "flow_reactor": flow_reactor_constraint}
+
+
+def load_plugin(name: str, options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
+    """Instantiate a constraint plugin by name: a built-in or a factory registered under the entry-point group."""
+    if not isinstance(options, Mapping):
+        raise ConfigError(f"constraint plugin '{name}': 'options' must be a mapping")
+    if name in BUILTIN_PLUGINS:
+        return BUILTIN_PLUGINS[name](options, names)
+    found = [ep for ep in entry_points(group=PLUGIN_GROUP) if ep.name == name]
+    if not found:
+        available = sorted(set(BUILTIN_PLUGINS) | {ep.name for ep in entry_points(group=PLUGIN_GROUP)})
+        raise ConfigError(f"unknown constraint plugin '{name}'; available: {available}")
+    try:
+        factory = found[0].load()
+        constraint = factory(dict(options))
+    except ConfigError:
+        raise
+    except Exception as exc:
+        raise ConfigError(f"constraint plugin '{name}' failed to load: {type(exc).__name__}: {exc}") from exc
+    if not callable(constraint):
+        raise ConfigError(f"constraint plugin '{name}' returned {type(constraint).__name__}, not a callable")
+    return NamedConstraint(getattr(constraint, "name", name), constraint, getattr(constraint, "evaluate_columns", None))
+
+
+def constraint_from_spec(spec: Any, position: int, names: Sequence[str]) -> NamedConstraint:
+    """A config entry: an expression string, ``{expression: ...}`` or ``{plugin: NAME, options: {...}}``."""
+    if isinstance(spec, str):
+        return expression_constraint({"expression": spec}, names)
+    if isinstance(spec, Mapping):
+        unknown = set(spec) - {"plugin", "options", "expression", "name"}
+        if unknown:
+            raise ConfigError(f"constraints[{position}]: unknown key(s) {sorted(unknown)}")
+        if "expression" in spec:
+            if "plugin" in spec:
+                raise ConfigError(f"constraints[{position}]: give 'expression' or 'plugin', not both")
+            constraint = expression_constraint(spec, names)
+        elif isinstance(spec.get("plugin"), str):
+            constraint = load_plugin(spec["plugin"], spec.get("options", {}), names)
+        else:
+            raise ConfigError(f"constraints[{position}]: needs an 'expression' string or a 'plugin' name")
+        if "name" in spec:
+            constraint.name = str(spec["name"])
+        return constraint
+    raise ConfigError(f"constraints[{position}] must be an expression string or a mapping, got {type(spec).__name__}")
+
+
+def _callable_name(fn: Callable, position: int) -> str:
+    name = getattr(fn, "__name__", None) or type(fn).__name__
+    return name if name != "<lambda>" else f"known_constraints[{position}]"
+
+
+class KnownConstraints:
+    """The AND of all known constraints of a campaign, evaluated on internal points or parameter dicts."""
+
+    def __init__(self, space: SearchSpace, constraints: Sequence[NamedConstraint] = ()):
+        self.space = space
+        self.constraints = list(constraints)
+
+    @classmethod
+    def build(cls, space: SearchSpace, specs: Sequence[Any] = (),
+              callables: Callable | Sequence[Callable] | None = None) -> "KnownConstraints":
+        constraints = [constraint_from_spec(s, i, space.names) for i, s in enumerate(specs)]
+        if callables is not None:
+            fns = [callables] if callable(callables) else list(callables)
+            for i, fn in enumerate(fns):
+                if not callable(fn):
+                    raise ConfigError(f"known_constraints[{i}] is {type(fn).__name__}, not a callable")
+                constraints.append(NamedConstraint(_callable_name(fn, i), fn))
+        return cls(space, constraints)
+
+    def __bool__(self) -> bool:
+        return bool(self.constraints)
+
+    def feasible(self, X: np.ndarray) -> np.ndarray:
+        """(M, D) internal points -> (M,) bool. A constraint that raises becomes a ConstraintError naming it."""
+        ok = np.ones(len(X), dtype=bool)
+        if not self.constraints or not len(X):
+            return ok
+        columns = self.space.columns(X)
+        rows = None
+        for c in self.constraints:
+            idx = np.flatnonzero(ok)
+            if not idx.size:
+                break
+            if c.columns_fn is not None:
+                try:
+                    result = np.asarray(c.columns_fn({k: v[idx] for k, v in columns.items()}))
+                except Exception as exc:
+                    raise ConstraintError(f"known constraint '{c.name}' raised {type(exc).__name__}: {exc}") from exc
+                if result.dtype != bool or result.shape != idx.shape:
+                    raise ConstraintError(f"known constraint '{c.name}' did not return one true/false per point")
+                ok[idx] = result
+                continue
+            if rows is None:
+                rows = self.space.to_params(X)
+            for i in idx:
+                ok[i] = self._call(c, rows[i])
+        return ok
+
+    def is_feasible(self, params: Mapping[str, Any]) -> bool:
+        return bool(self.feasible(self.space.to_internal([params]))[0])
+
+    def violated(self, params: Mapping[str, Any]) -> list[str]:
+        """Names of the constraints a (valid) parameter dict violates."""
+        X = self.space.to_internal([params])
+        return [c.name for c in self.constraints if not KnownConstraints(self.space, [c]).feasible(X)[0]]
+
+    @staticmethod
+    def _call(c: NamedConstraint, params: dict) -> bool:
+        try:
+            result = c.fn(dict(params))
+        except Exception as exc:
+            raise ConstraintError(
+                f"known constraint '{c.name}' raised {type(exc).__name__}: {exc} for parameters {params}") from exc
+        if not isinstance(result, (bool, np.bool_)):
+            raise ConstraintError(
+                f"known constraint '{c.name}' returned {result!r} ({type(result).__name__}) for {params}; "
+                "it must return True (feasible) or False (infeasible)")
+        return bool(result)
+
+
+@dataclass(frozen=True)
+class FeasibleFraction:
+    """V_C, the feasible fraction of the domain, with how it was obtained."""
+
+    value: float
+    stderr: float
+    method: str  # "given" | "unconstrained" | "enumerated" | "monte_carlo"
+    samples: int = 0
+
+
+def estimate_feasible_fraction(constraints: KnownConstraints, rng: np.random.Generator,
+                               samples: int = 20000, max_samples: int = 2_000_000) -> FeasibleFraction:
+    """Exact enumeration for finite spaces up to 10^6 points, else Monte Carlo with its standard error.
+
+    Monte Carlo keeps doubling the sample when nothing feasible is found, up to ``max_samples``; if still nothing is
+    feasible the constraints are taken to exclude (almost) the whole domain and a NoFeasiblePointError is raised.
+    """
+    space = constraints.space
+    if not constraints:
+        return FeasibleFraction(1.0, 0.0, "unconstrained")
+    size = space.finite_size
+    if size is not None and size <= ENUMERATION_LIMIT:
+        hits = 0
+        points = space.enumerate()
+        for start in range(0, len(points), 100_000):
+            hits += int(constraints.feasible(points[start:start + 100_000]).sum())
+        if hits == 0:
+            raise NoFeasiblePointError(f"none of the {size} points of the search space satisfies the known constraints")
+        return FeasibleFraction(hits / size, 0.0, "enumerated", size)
+    hits, drawn, batch = 0, 0, samples
+    while True:
+        hits += int(constraints.feasible(space.sample(rng, batch)).sum())
+        drawn += batch
+        if hits >= 10 or drawn >= max_samples:
+            break
+        batch = min(drawn, max_samples - drawn)
+    if hits == 0:
+        raise NoFeasiblePointError(
+            f"no point satisfying the known constraints was found in {drawn} uniform samples of the domain "
+            f"(feasible fraction below ~{1 / drawn:.1e}); check that the constraints do not contradict each other")
+    p = hits / drawn
+    return FeasibleFraction(p, math.sqrt(p * (1 - p) / drawn), "monte_carlo", drawn)

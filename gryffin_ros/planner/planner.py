@@ -1,0 +1,369 @@
+"""The ask/tell facade: campaign bookkeeping shared by every strategy, and the constrained kernel-density Planner.
+
+A strategy only implements ``_propose(n, rng)``; validation of observations, pending proposals, determinism
+(every random draw derives from the seed, the number of observations and the number of asks), ``best()`` and the
+JSON state live in :class:`BasePlanner`.
+"""
+
+from __future__ import annotations
+
+import math
+import secrets
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+import torch
+
+from .acquisition import Acquisition
+from .adam_hill import AdamHillOptimizer
+from .config import PlannerConfig, load_config
+from .constraints import FeasibleFraction, KnownConstraints, estimate_feasible_fraction
+from .errors import ConfigError, ExhaustedSpaceError, NoFeasiblePointError, ObservationError
+from .genetic import GeneticOptimizer
+from .kernel_density import KernelDensity
+from .sampling import perturb, rejection_sample
+from .selection import duplicates, select
+
+STATE_FORMAT = 1
+# Finite spaces with at most this many feasible points are searched exhaustively instead of from random starts.
+EXHAUSTIVE_LIMIT = 20_000
+ConstraintArg = Callable[[dict], bool] | Sequence[Callable[[dict], bool]] | None
+
+
+@dataclass
+class Observation:
+    """One reported experiment. ``objectives`` maps each objective name to a float, or None for a failed experiment."""
+
+    params: dict[str, Any]
+    objectives: dict[str, float | None]
+    experiment_id: str | None = None
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def failed(self) -> bool:
+        return any(v is None for v in self.objectives.values())
+
+    def to_dict(self) -> dict[str, Any]:
+        out = {"experiment_id": self.experiment_id, "params": dict(self.params), "objectives": dict(self.objectives)}
+        if self.meta:
+            out["meta"] = dict(self.meta)
+        return out
+
+
+@dataclass
+class Proposal:
+    """One experiment to run: its id, its parameters in users' units and the sampling strategy that chose it."""
+
+    experiment_id: str
+    params: dict[str, Any]
+    strategy: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"experiment_id": self.experiment_id, "params": dict(self.params), "strategy": self.strategy}
+
+
+def _objective_value(name: str, value: Any) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ObservationError(f"objective '{name}' must be a number or null, got {value!r}")
+    value = float(value)
+    if math.isnan(value):
+        return None
+    if math.isinf(value):
+        raise ObservationError(f"objective '{name}' = {value} is not finite; report a failed experiment as null")
+    return value
+
+
+class BasePlanner:
+    """Campaign state and validation shared by the kernel-density Planner and the Random/Genetic baselines."""
+
+    def __init__(self, config: Mapping | str | Path | PlannerConfig, known_constraints: ConstraintArg = None,
+                 seed: int | None = None):
+        self.config = config if isinstance(config, PlannerConfig) else load_config(config)
+        self.space = self.config.space
+        self.objectives = self.config.objectives
+        self.constraints = KnownConstraints.build(self.space, self.config.constraint_specs, known_constraints)
+        self._known_constraints = known_constraints
+        if seed is None:
+            seed = self.config.general.random_seed
+        if seed is None:
+            seed = secrets.randbits(63)
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+        self.seed = int(seed)
+        self.observations: list[Observation] = []
+        self.pending: dict[str, Proposal] = {}
+        self._ask_count = 0
+        self._proposal_count = 0
+        self._feasible_fraction: FeasibleFraction | None = None
+        self._feasible_set: np.ndarray | None = None
+
+    # ---- randomness ------------------------------------------------------------------------------------------
+    def _rng(self, purpose: int) -> np.random.Generator:
+        """Same seed, same observations, same number of asks -> same draws."""
+        return np.random.default_rng([self.seed, len(self.observations), self._ask_count, purpose])
+
+    # ---- feasible set ----------------------------------------------------------------------------------------
+    @property
+    def feasible_fraction(self) -> FeasibleFraction:
+        """V_C: given in the config, exact for finite spaces up to 10^6 points, else Monte Carlo (cached)."""
+        if self._feasible_fraction is None:
+            given = self.config.general.feasible_fraction
+            if given is not None:
+                self._feasible_fraction = FeasibleFraction(float(given), 0.0, "given")
+            else:
+                self._feasible_fraction = estimate_feasible_fraction(self.constraints, self._rng(1))
+        return self._feasible_fraction
+
+    def feasible_set(self) -> np.ndarray | None:
+        """Every feasible point of a finite space small enough to search exhaustively, else None (cached)."""
+        size = self.space.finite_size
+        if size is None or size > 50 * EXHAUSTIVE_LIMIT:
+            return None
+        if self._feasible_set is None:
+            points = self.space.enumerate()
+            self._feasible_set = points[self.constraints.feasible(points)]
+        return self._feasible_set if len(self._feasible_set) <= EXHAUSTIVE_LIMIT else None
+
+    # ---- observations ----------------------------------------------------------------------------------------
+    def parse_observation(self, item: Mapping[str, Any] | Observation) -> Observation:
+        """Validate one observation: Gryffin style (parameters and objectives as keys, optional experiment_id) or
+        structured ``{experiment_id, params, objectives, meta}``. Raises ObservationError naming what is wrong."""
+        if isinstance(item, Observation):
+            params, objectives, experiment_id, meta = item.params, item.objectives, item.experiment_id, item.meta
+        elif isinstance(item, Mapping):
+            if "params" in item and "params" not in self.space.names:
+                unknown = set(item) - {"experiment_id", "params", "objectives", "meta"}
+                if unknown:
+                    raise ObservationError(f"unknown observation field(s) {sorted(unknown)}")
+                params, objectives = item["params"], item.get("objectives")
+                experiment_id, meta = item.get("experiment_id"), item.get("meta") or {}
+                if objectives is None:
+                    objectives = {o.name: None for o in self.objectives}
+            else:
+                names = {o.name for o in self.objectives}
+                unknown = set(item) - set(self.space.names) - names - {"experiment_id"}
+                if unknown:
+                    raise ObservationError(f"unknown key(s) {sorted(unknown)}; parameters are {list(self.space.names)}, "
+                                           f"objectives {sorted(names)}")
+                params = {k: item[k] for k in self.space.names if k in item}
+                objectives = {k: item.get(k) for k in names}
+                experiment_id, meta = item.get("experiment_id"), {}
+        else:
+            raise ObservationError(f"an observation must be a mapping, got {type(item).__name__}")
+        if not isinstance(params, Mapping):
+            raise ObservationError("'params' must be a mapping")
+        if not isinstance(objectives, Mapping):
+            raise ObservationError("'objectives' must be a mapping or null")
+        if experiment_id is not None and not isinstance(experiment_id, str):
+            raise ObservationError(f"experiment_id must be a string, got {experiment_id!r}")
+        unknown = set(params) - set(self.space.names)
+        if unknown:
+            raise ObservationError(f"unknown parameter(s) {sorted(unknown)}; parameters are {list(self.space.names)}")
+        X = self.space.to_internal([params])
+        clean = self.space.to_params(X)[0]
+        for d in self.space.cont_idx:  # keep the caller's exact continuous values, not a unit round trip
+            clean[self.space.names[d]] = float(params[self.space.names[d]])
+        known = {o.name for o in self.objectives}
+        extra = set(objectives) - known
+        if extra:
+            raise ObservationError(f"unknown objective(s) {sorted(extra)}; objectives are {sorted(known)}")
+        missing = known - set(objectives)
+        if missing:
+            raise ObservationError(f"missing objective(s) {sorted(missing)}")
+        values = {name: _objective_value(name, objectives[name]) for name in known}
+        violated = self.constraints.violated(clean)
+        if violated:
+            raise ObservationError(f"parameters {clean} violate the known constraint(s) {violated}")
+        return Observation(clean, values, experiment_id, dict(meta))
+
+    def tell(self, observations: Mapping | Observation | Sequence[Mapping | Observation]) -> list[Observation]:
+        """Add observations (all or none: the whole batch is validated first). Returns the stored Observations."""
+        if isinstance(observations, (Mapping, Observation)):
+            observations = [observations]
+        parsed = [self.parse_observation(o) for o in observations]
+        seen = {o.experiment_id for o in self.observations if o.experiment_id is not None}
+        for o in parsed:
+            if o.experiment_id is not None:
+                if o.experiment_id in seen:
+                    raise ObservationError(f"experiment_id '{o.experiment_id}' was already reported")
+                seen.add(o.experiment_id)
+        for o in parsed:
+            self.observations.append(o)
+            if o.experiment_id is not None:
+                self.pending.pop(o.experiment_id, None)
+        return parsed
+
+    def _internal(self, rows: Sequence[Mapping[str, Any]]) -> np.ndarray:
+        return self.space.to_internal(rows) if rows else np.empty((0, self.space.dim))
+
+    def observed_points(self) -> np.ndarray:
+        return self._internal([o.params for o in self.observations])
+
+    def pending_points(self) -> np.ndarray:
+        return self._internal([p.params for p in self.pending.values()])
+
+    def merits(self, observations: Sequence[Observation]) -> np.ndarray:
+        """Objective values as minimization merits in [0, 1] (max goals negated; sqrt transform by default)."""
+        objective = self.objectives[0]
+        y = np.array([o.objectives[objective.name] for o in observations], dtype=float)
+        if objective.goal == "max":
+            y = -y
+        span = y.max() - y.min() if len(y) else 0.0
+        f = (y - y.min()) / span if span > 0 else np.zeros_like(y)
+        return np.sqrt(f) if self.config.general.obj_transform == "sqrt" else f
+
+    def best(self) -> Observation | None:
+        """The best successful observation so far (None before the first one)."""
+        successful = [o for o in self.observations if not o.failed]
+        if not successful:
+            return None
+        return successful[int(np.argmin(self.merits(successful)))]
+
+    # ---- proposals -------------------------------------------------------------------------------------------
+    def ask(self, n: int | None = None) -> list[Proposal]:
+        """The next n proposals (default: general.batches); each feasible, none repeating a point of a finite space
+        that was observed or is pending."""
+        n = self.config.general.batches if n is None else n
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise ValueError(f"n must be a positive integer, got {n!r}")
+        rng = self._rng(2)
+        points, strategies = self._propose(n, rng)
+        self._ask_count += 1
+        proposals = []
+        for x, strategy, params in zip(points, strategies, self.space.to_params(points)):
+            proposal = Proposal(str(uuid.uuid4()), params, strategy)
+            self.pending[proposal.experiment_id] = proposal
+            proposals.append(proposal)
+        return proposals
+
+    def recommend(self, observations: Sequence[Mapping[str, Any]] | None = None) -> list[dict[str, Any]]:
+        """Gryffin-compatible and stateless: parameter dicts for the given observations, one per (batch, strategy)."""
+        fresh = type(self)(self.config, self._known_constraints, self.seed)
+        fresh._feasible_fraction, fresh._feasible_set = self._feasible_fraction, self._feasible_set
+        if observations:
+            fresh.tell(list(observations))
+        general = self.config.general
+        return [p.params for p in fresh.ask(general.batches * general.sampling_strategies)]
+
+    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None]]:
+        raise NotImplementedError
+
+    def random_points(self, n: int, rng: np.random.Generator, avoid: np.ndarray) -> np.ndarray:
+        """n feasible points drawn uniformly, none duplicating `avoid` or each other in a finite space."""
+        feasible = self.feasible_set()
+        if feasible is not None:
+            free = feasible[~duplicates(self.space, feasible, avoid)]
+            if len(free) < n:
+                raise ExhaustedSpaceError(
+                    f"only {len(free)} feasible point(s) of the search space are neither observed nor pending; "
+                    f"{n} requested")
+            return free[rng.choice(len(free), n, replace=False)]
+        chosen = np.empty((0, self.space.dim))
+        for _ in range(20):
+            need = n - len(chosen)
+            X = rejection_sample(self.constraints, rng, 4 * need, self.config.general.max_rejection_draws,
+                                 self.feasible_fraction.value)
+            if not len(X):
+                break
+            for x in X:
+                if len(chosen) < n and not duplicates(self.space, x[None], np.concatenate([avoid, chosen]))[0]:
+                    chosen = np.concatenate([chosen, x[None]])
+            if len(chosen) == n:
+                return chosen
+        raise NoFeasiblePointError(
+            f"could not draw {n} new feasible point(s) within {self.config.general.max_rejection_draws} uniform "
+            f"samples per try (estimated feasible fraction {self.feasible_fraction.value:.2e})")
+
+    # ---- persistence -----------------------------------------------------------------------------------------
+    def state(self) -> dict[str, Any]:
+        """A JSON-serializable snapshot; ``from_state`` rebuilds an identical planner (pass callables again)."""
+        return {
+            "format": STATE_FORMAT, "strategy": type(self).__name__, "config": self.config.raw, "seed": self.seed,
+            "observations": [o.to_dict() for o in self.observations],
+            "pending": [p.to_dict() for p in self.pending.values()],
+            "ask_count": self._ask_count, "proposal_count": self._proposal_count,
+        }
+
+    @classmethod
+    def from_state(cls, state: Mapping[str, Any], known_constraints: ConstraintArg = None) -> "BasePlanner":
+        if not isinstance(state, Mapping) or state.get("format") != STATE_FORMAT:
+            raise ConfigError(f"not a planner state of format {STATE_FORMAT}")
+        if state.get("strategy") != cls.__name__:
+            raise ConfigError(f"state was saved by {state.get('strategy')!r}, not {cls.__name__}")
+        planner = cls(state["config"], known_constraints, state["seed"])
+        planner.observations = [planner.parse_observation(o) for o in state["observations"]]
+        planner.pending = {p["experiment_id"]: Proposal(p["experiment_id"], p["params"], p.get("strategy"))
+                           for p in state["pending"]}
+        planner._ask_count = int(state["ask_count"])
+        planner._proposal_count = int(state["proposal_count"])
+        return planner
+
+
+class Planner(BasePlanner):
+    """Gryffin with known constraints: kernel-density surrogate, lambda strategies, constrained Adam+Hill or genetic
+    acquisition optimization, diversity-aware selection."""
+
+    def strategy_values(self) -> np.ndarray:
+        """Sampling strategies s, from exploitation (+1) to exploration (-1); a single strategy is s = 0."""
+        count = self.config.general.sampling_strategies
+        return np.linspace(1.0, -1.0, count) if count > 1 else np.zeros(1)
+
+    def _optimizer(self) -> AdamHillOptimizer | GeneticOptimizer:
+        if self.config.general.acquisition_optimizer == "genetic":
+            return GeneticOptimizer(self.constraints)
+        return AdamHillOptimizer(self.constraints)
+
+    def _start_points(self, rng: np.random.Generator, incumbent: np.ndarray, feasible_observed: np.ndarray
+                      ) -> tuple[np.ndarray, bool]:
+        """Start points and whether they are the whole feasible set (then no local refinement is needed)."""
+        feasible = self.feasible_set()
+        if feasible is not None:
+            return feasible, True
+        m = self.config.general.num_random_samples * self.space.dim
+        uniform = rejection_sample(self.constraints, rng, m, self.config.general.max_rejection_draws,
+                                   self.feasible_fraction.value)
+        start = np.concatenate([uniform, perturb(self.constraints, rng, incumbent, m)])
+        if len(uniform) < m:
+            start = np.concatenate([start, feasible_observed])
+        return start, False
+
+    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None]]:
+        observed = self.observed_points()
+        chosen = self.pending_points()
+        successful = [o for o in self.observations if not o.failed]
+        if not successful:
+            return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n
+        X = self._internal([o.params for o in successful])
+        merits = self.merits(successful)
+        generator = torch.Generator().manual_seed(int(rng.integers(2**63)))
+        density = KernelDensity(self.space, X, merits, self.feasible_fraction.value, generator)
+        start, exhaustive = self._start_points(rng, X[int(np.argmin(merits))], X)
+        values = self.strategy_values()
+        optimizer = self._optimizer()
+        refined: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        points, strategies = [], []
+        for _ in range(n):
+            s = float(values[self._proposal_count % len(values)])
+            self._proposal_count += 1
+            if s not in refined:
+                acquisition = Acquisition(density, s)
+                if exhaustive:
+                    candidates, alpha = start, acquisition.evaluate(start)
+                else:
+                    candidates, alpha = optimizer.optimize(acquisition, start, rng)
+                    keep = self.constraints.feasible(candidates)  # guaranteed by the optimizers; never trusted blindly
+                    candidates, alpha = candidates[keep], alpha[keep]
+                refined[s] = (candidates, alpha)
+            candidates, alpha = refined[s]
+            index = select(self.space, candidates, alpha, observed, chosen) if len(candidates) else None
+            x = candidates[index] if index is not None else self.random_points(
+                1, rng, np.concatenate([observed, chosen]))[0]
+            chosen = np.concatenate([chosen, x[None]])
+            points.append(x)
+            strategies.append(s)
+        return np.array(points), strategies

@@ -1,0 +1,41 @@
+"""gryffin_ros: constrained Bayesian optimization (Gryffin with known constraints) as a ROS 2 Jazzy node."""
+
+from pathlib import Path
+
+from setuptools import find_packages, setup
+
+PACKAGE = "gryffin_ros"
+
+setup(
+    name=PACKAGE,
+    version="0.1.0",
+    description="Experiment planner for self-driving labs: Gryffin with known constraints, as a ROS 2 node",
+    long_description=Path(__file__).with_name("README.md").read_text(),
+    long_description_content_type="text/markdown",
+    license="Apache-2.0",
+    python_requires=">=3.10",
+    packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
+    include_package_data=True,
+    package_data={PACKAGE: ["examples/*.yaml"]},
+    data_files=[
+        (f"share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
+        (f"share/{PACKAGE}", ["package.xml"]),
+        (f"share/{PACKAGE}/msg_schemas", [str(p) for p in Path("msg_schemas").glob("*.json")]),
+    ],
+    install_requires=[
+        "numpy>=1.24",
+        "torch>=2.2",
+        "deap>=1.4",
+        "jsonschema>=4.0",
+        "PyYAML>=6.0",
+    ],
+    extras_require={
+        "test": ["pytest>=8", "hypothesis>=6", "ruff>=0.5"],
+        "ros": ["ros-jazzy-rclpy", "ros-jazzy-common-interfaces", "ros-jazzy-rmw-fastrtps-cpp"],
+    },
+    entry_points={
+        "console_scripts": [
+            "gryffin-ros = gryffin_ros.cli:main",
+        ],
+    },
+)
