@@ -103,9 +103,9 @@ class BasePlanner:
         self._feasible_set: np.ndarray | None = None
 
     # ---- randomness ------------------------------------------------------------------------------------------
-    def _rng(self, purpose: int) -> np.random.Generator:
+    def _rng(self) -> np.random.Generator:
         """Same seed, same observations, same number of asks -> same draws."""
-        return np.random.default_rng([self.seed, len(self.observations), self._ask_count, purpose])
+        return np.random.default_rng([self.seed, len(self.observations), self._ask_count, 2])
 
     # ---- feasible set ----------------------------------------------------------------------------------------
     @property
@@ -116,7 +116,9 @@ class BasePlanner:
             if given is not None:
                 self._feasible_fraction = FeasibleFraction(float(given), 0.0, "given")
             else:
-                self._feasible_fraction = estimate_feasible_fraction(self.constraints, self._rng(1))
+                # a stream of its own that depends on the seed alone: V_C must not change with campaign progress
+                rng = np.random.default_rng([self.seed, 1])
+                self._feasible_fraction = estimate_feasible_fraction(self.constraints, rng)
         return self._feasible_fraction
 
     def feasible_set(self) -> np.ndarray | None:
@@ -231,7 +233,7 @@ class BasePlanner:
         n = self.config.general.batches if n is None else n
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise ValueError(f"n must be a positive integer, got {n!r}")
-        rng = self._rng(2)
+        rng = self._rng()
         points, strategies = self._propose(n, rng)
         self._ask_count += 1
         proposals = []

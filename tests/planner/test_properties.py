@@ -1,0 +1,104 @@
+"""Property tests: across random mixed spaces and random constraints, no proposal is ever infeasible, out of
+bounds or of the wrong type, whichever acquisition optimizer runs."""
+
+import math
+
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from gryffin_ros.planner import Genetic, Planner, Random
+
+
+@st.composite
+def problems(draw):
+    """A random space, an anchor point known to be feasible, and constraints (text + independent Python check)."""
+    n = draw(st.integers(1, 4))
+    specs, anchor = [], {}
+    for i in range(n):
+        kind = draw(st.sampled_from(["continuous", "discrete", "categorical"]))
+        name = f"p{i}"
+        if kind == "continuous":
+            low = draw(st.floats(-1000, 1000, allow_nan=False))
+            span = draw(st.floats(0.01, 500))
+            spec = {"name": name, "type": kind, "low": low, "high": low + span,
+                    "periodic": draw(st.booleans())}
+            anchor[name] = draw(st.floats(low, low + span))
+        elif kind == "discrete":
+            low = draw(st.integers(-20, 20))
+            spec = {"name": name, "type": kind, "low": low, "high": low + draw(st.integers(1, 15))}
+            anchor[name] = draw(st.integers(spec["low"], spec["high"]))
+        else:
+            options = [f"o{j}" for j in range(draw(st.integers(2, 5)))]
+            spec = {"name": name, "type": kind, "options": options}
+            if draw(st.booleans()):
+                spec["descriptors"] = {o: [draw(st.floats(-5, 5)), float(j)] for j, o in enumerate(options)}
+            anchor[name] = draw(st.sampled_from(options))
+        specs.append(spec)
+    numeric = [s["name"] for s in specs if s["type"] != "categorical"]
+    categorical = [s for s in specs if s["type"] == "categorical"]
+    texts, checks = [], []
+    for _ in range(draw(st.integers(0, 3))):
+        if numeric and (not categorical or draw(st.booleans())):
+            weights = {name: draw(st.floats(-2, 2)) for name in numeric}
+            margin = draw(st.floats(0, 50))
+            bound = sum(w * anchor[k] for k, w in weights.items()) + margin
+            texts.append(" + ".join(f"({w!r}) * {k}" for k, w in weights.items()) + f" <= {bound!r}")
+            checks.append(lambda p, w=weights, b=bound: sum(c * p[k] for k, c in w.items()) <= b + 1e-9)
+        elif categorical:
+            spec = draw(st.sampled_from(categorical))
+            banned = draw(st.sampled_from([o for o in spec["options"] if o != anchor[spec["name"]]]))
+            texts.append(f"{spec['name']} != '{banned}'")
+            checks.append(lambda p, k=spec["name"], b=banned: p[k] != b)
+    return specs, texts, checks
+
+
+def assert_valid(specs, checks, params):
+    assert set(params) == {s["name"] for s in specs}
+    for spec in specs:
+        value = params[spec["name"]]
+        if spec["type"] == "continuous":
+            assert type(value) is float and spec["low"] <= value <= spec["high"]
+        elif spec["type"] == "discrete":
+            assert type(value) is int and spec["low"] <= value <= spec["high"]
+        else:
+            assert type(value) is str and value in spec["options"]
+    for check in checks:
+        assert check(params), params
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(problem=problems(), optimizer=st.sampled_from(["adam", "genetic"]), seed=st.integers(0, 2**31))
+def test_planner_proposals_are_always_feasible_in_bounds_and_typed(problem, optimizer, seed):
+    specs, texts, checks = problem
+    config = {"parameters": specs, "objectives": [{"name": "y", "goal": "min"}], "constraints": texts,
+              "general": {"acquisition_optimizer": optimizer, "num_random_samples": 15}}
+    planner = Planner(config, seed=seed)
+    rng = np.random.default_rng(seed)
+    for _ in range(3):
+        try:
+            proposals = planner.ask(2)
+        except Exception as exc:  # a finite space may run out of new feasible points; nothing else may fail
+            assert type(exc).__name__ == "ExhaustedSpaceError", exc
+            return
+        for proposal in proposals:
+            assert_valid(specs, checks, proposal.params)
+            y = None if rng.random() < 0.1 else float(rng.normal())
+            planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
+
+
+@settings(max_examples=15, deadline=None)
+@given(problem=problems(), seed=st.integers(0, 2**31))
+def test_baseline_proposals_are_always_feasible(problem, seed):
+    specs, texts, checks = problem
+    config = {"parameters": specs, "objectives": [{"name": "y", "goal": "max"}], "constraints": texts}
+    for strategy in (Random, Genetic):
+        planner = strategy(config, seed=seed)
+        for i in range(25):
+            try:
+                (proposal,) = planner.ask()
+            except Exception as exc:
+                assert type(exc).__name__ == "ExhaustedSpaceError", exc
+                break
+            assert_valid(specs, checks, proposal.params)
+            planner.tell({**proposal.params, "y": math.sin(i), "experiment_id": proposal.experiment_id})
