@@ -1,8 +1,6 @@
 """Property tests: across random mixed spaces and random constraints, no proposal is ever infeasible, out of
 bounds or of the wrong type, whichever acquisition optimizer runs."""
 
-import math
-
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -41,7 +39,7 @@ def problems(draw):
     for _ in range(draw(st.integers(0, 3))):
         if numeric and (not categorical or draw(st.booleans())):
             weights = {name: draw(st.floats(-2, 2)) for name in numeric}
-            margin = draw(st.floats(0, 50))
+            margin = draw(st.floats(0, 5))
             bound = sum(w * anchor[k] for k, w in weights.items()) + margin
             texts.append(" + ".join(f"({w!r}) * {k}" for k, w in weights.items()) + f" <= {bound!r}")
             checks.append(lambda p, w=weights, b=bound: sum(c * p[k] for k, c in w.items()) <= b + 1e-9)
@@ -50,7 +48,17 @@ def problems(draw):
             banned = draw(st.sampled_from([o for o in spec["options"] if o != anchor[spec["name"]]]))
             texts.append(f"{spec['name']} != '{banned}'")
             checks.append(lambda p, k=spec["name"], b=banned: p[k] != b)
-    return specs, texts, checks
+    return specs, texts, checks, objective_against(texts, checks, numeric)
+
+
+def objective_against(texts, checks, numeric):
+    """An objective whose optimum lies outside the first linear constraint, so the optimizers press against it."""
+    linear = [t for t in texts if "<=" in t]
+    if not linear:
+        return lambda p: sum(float(p[k]) for k in numeric)
+    check = checks[texts.index(linear[0])]
+    weights = check.__defaults__[0]
+    return lambda p: -sum(w * p[k] for k, w in weights.items())
 
 
 def assert_valid(specs, checks, params):
@@ -70,12 +78,12 @@ def assert_valid(specs, checks, params):
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(problem=problems(), optimizer=st.sampled_from(["adam", "genetic"]), seed=st.integers(0, 2**31))
 def test_planner_proposals_are_always_feasible_in_bounds_and_typed(problem, optimizer, seed):
-    specs, texts, checks = problem
+    specs, texts, checks, objective = problem
     config = {"parameters": specs, "objectives": [{"name": "y", "goal": "min"}], "constraints": texts,
               "general": {"acquisition_optimizer": optimizer, "num_random_samples": 15}}
     planner = Planner(config, seed=seed)
     rng = np.random.default_rng(seed)
-    for _ in range(3):
+    for _ in range(5):
         try:
             proposals = planner.ask(2)
         except Exception as exc:  # a finite space may run out of new feasible points; nothing else may fail
@@ -83,15 +91,15 @@ def test_planner_proposals_are_always_feasible_in_bounds_and_typed(problem, opti
             return
         for proposal in proposals:
             assert_valid(specs, checks, proposal.params)
-            y = None if rng.random() < 0.1 else float(rng.normal())
+            y = None if rng.random() < 0.1 else objective(proposal.params)
             planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
 
 
 @settings(max_examples=15, deadline=None)
 @given(problem=problems(), seed=st.integers(0, 2**31))
 def test_baseline_proposals_are_always_feasible(problem, seed):
-    specs, texts, checks = problem
-    config = {"parameters": specs, "objectives": [{"name": "y", "goal": "max"}], "constraints": texts}
+    specs, texts, checks, objective = problem
+    config = {"parameters": specs, "objectives": [{"name": "y", "goal": "min"}], "constraints": texts}
     for strategy in (Random, Genetic):
         planner = strategy(config, seed=seed)
         for i in range(25):
@@ -101,4 +109,4 @@ def test_baseline_proposals_are_always_feasible(problem, seed):
                 assert type(exc).__name__ == "ExhaustedSpaceError", exc
                 break
             assert_valid(specs, checks, proposal.params)
-            planner.tell({**proposal.params, "y": math.sin(i), "experiment_id": proposal.experiment_id})
+            planner.tell({**proposal.params, "y": objective(proposal.params), "experiment_id": proposal.experiment_id})
