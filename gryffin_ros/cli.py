@@ -6,8 +6,8 @@ import argparse
 import math
 import sys
 import time
+from collections.abc import Sequence
 from importlib import resources
-from typing import Sequence
 
 from .planner import GryffinRosError, Planner
 

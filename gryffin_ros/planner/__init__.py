@@ -5,8 +5,14 @@ constrained acquisition optimizers and the ask/tell Planner (plus Random and Gen
 from .baselines import Genetic, Random
 from .config import PlannerConfig, load_config
 from .constraints import FeasibleFraction, KnownConstraints
-from .errors import (ConfigError, ConstraintError, ExhaustedSpaceError, GryffinRosError, NoFeasiblePointError,
-                     ObservationError)
+from .errors import (
+                     ConfigError,
+                     ConstraintError,
+                     ExhaustedSpaceError,
+                     GryffinRosError,
+                     NoFeasiblePointError,
+                     ObservationError,
+)
 from .expressions import Expression
 from .planner import BasePlanner, Observation, Planner, Proposal
 from .space import SearchSpace

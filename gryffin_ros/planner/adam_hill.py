@@ -6,11 +6,11 @@ a Hill move is kept only when it improves alpha and stays feasible.
 from __future__ import annotations
 
 import numpy as np
-import torch
 
 from .acquisition import Acquisition
 from .constraints import KnownConstraints
-from .kernel_density import DTYPE
+
+BETA1, BETA2, EPSILON = 0.9, 0.999, 1e-8
 
 
 class AdamHillOptimizer:
@@ -24,46 +24,58 @@ class AdamHillOptimizer:
 
     def optimize(self, acquisition: Acquisition, start: np.ndarray, rng: np.random.Generator
                  ) -> tuple[np.ndarray, np.ndarray]:
-        """Refine feasible start points (M, D) -> (refined points (M, D), alpha at them (M,)); all stay feasible."""
+        """Refine feasible start points (M, D) -> (refined points (M, D), alpha at them (M,)); all stay feasible.
+
+        Adam runs per point (its own moments, the usual bias correction). A point whose gradient and momentum are
+        exactly zero cannot move, so it is not evaluated again until a Hill move changes it.
+        """
         space = self.space
         X = start.copy()
-        active = np.ones(len(X), dtype=bool)
         c, f = space.cont_idx, space.finite_idx
-        xc = torch.tensor(X[:, c], dtype=DTYPE, requires_grad=True)
-        adam = torch.optim.Adam([xc], lr=self.learning_rate, betas=(0.9, 0.999))
-        alpha = acquisition.evaluate(X)
-        for _ in range(self.steps):
-            if c.size and active.any():
-                self._adam_step(acquisition, adam, xc, X, active)
-                alpha = acquisition.evaluate(X)
+        active = np.ones(len(X), dtype=bool)  # False once an Adam step would have left the feasible set
+        still = np.zeros(len(X), dtype=bool)
+        m, v = np.zeros((len(X), c.size)), np.zeros((len(X), c.size))
+        alpha = None if c.size else acquisition.evaluate(X)
+        for step in range(1, self.steps + 1):
+            if c.size:
+                alpha = self._adam_step(acquisition, X, alpha, active, still, m, v, step)
             if f.size:
-                alpha = self._hill_step(acquisition, X, alpha, active, rng)
+                moved = self._hill_step(acquisition, X, alpha, active, rng)
+                still[moved] = False
+        stale = np.flatnonzero(~still & active) if c.size else np.empty(0, dtype=int)
+        if stale.size:
+            alpha[stale] = acquisition.evaluate(X[stale])
         return X, alpha
 
-    def _adam_step(self, acquisition: Acquisition, adam: torch.optim.Adam, xc: torch.Tensor, X: np.ndarray,
-                   active: np.ndarray) -> None:
+    def _adam_step(self, acquisition: Acquisition, X: np.ndarray, alpha: np.ndarray | None, active: np.ndarray,
+                   still: np.ndarray, m: np.ndarray, v: np.ndarray, step: int) -> np.ndarray:
         space = self.space
-        xf = torch.as_tensor(np.rint(X[:, space.finite_idx]), dtype=torch.long)
-        adam.zero_grad()
-        step = acquisition.chunk_size()
-        for start in range(0, len(X), step):
-            # alpha of each point depends only on that point, so the gradient of the chunk's sum is per point
-            acquisition(xc[start:start + step], xf[start:start + step]).sum().backward()
-        adam.step()
-        moved = X.copy()
-        moved[:, space.cont_idx] = xc.detach().numpy()
-        moved = space.clip(moved)
-        idx = np.flatnonzero(active)
-        ok = self.constraints.feasible(moved[idx])
-        X[idx[ok]] = moved[idx[ok]]
-        active[idx[~ok]] = False
-        with torch.no_grad():
-            # frozen and clipped points restart each step from their accepted position
-            xc.copy_(torch.as_tensor(X[:, space.cont_idx], dtype=DTYPE))
+        idx = np.arange(len(X)) if alpha is None else np.flatnonzero(active & ~still)
+        values, grad = acquisition.value_and_grad(X[idx])
+        if alpha is None:
+            alpha = values
+        alpha[idx] = values
+        m[idx] = BETA1 * m[idx] + (1 - BETA1) * grad
+        v[idx] = BETA2 * v[idx] + (1 - BETA2) * grad ** 2
+        delta = self.learning_rate * (m[idx] / (1 - BETA1 ** step)) / (np.sqrt(v[idx] / (1 - BETA2 ** step)) + EPSILON)
+        frozen = ~delta.any(axis=1)
+        still[idx[frozen]] = True
+        idx, delta = idx[~frozen], delta[~frozen]
+        if idx.size:
+            moved = X[idx].copy()
+            moved[:, space.cont_idx] -= delta
+            moved = space.clip(moved)
+            ok = self.constraints.feasible(moved)
+            X[idx[ok]] = moved[ok]
+            active[idx[~ok]] = False
+        return alpha
 
     def _hill_step(self, acquisition: Acquisition, X: np.ndarray, alpha: np.ndarray, active: np.ndarray,
                    rng: np.random.Generator) -> np.ndarray:
+        """One random option per finite dim for every active point, kept where better and feasible; returns the
+        indices of the points that moved."""
         space = self.space
+        moved = []
         for d in rng.permutation(space.finite_idx):
             idx = np.flatnonzero(active)
             if not idx.size:
@@ -76,4 +88,6 @@ class AdamHillOptimizer:
                 better[better] = self.constraints.feasible(trial[better])
             X[idx[better]] = trial[better]
             alpha[idx[better]] = trial_alpha[better]
-        return alpha
+            moved.append(idx[better])
+        return np.concatenate(moved) if moved else np.empty(0, dtype=int)
+

@@ -7,8 +7,16 @@ from __future__ import annotations
 import numpy as np
 from deap import tools
 
-from .genetic import (CROSSOVER_PROB, MUTATION_PROB, TOURNAMENT_SIZE, crossover, mutate, project_to_feasible,
-                      seeded_python_random, to_individuals)
+from .genetic import (
+    CROSSOVER_PROB,
+    MUTATION_PROB,
+    TOURNAMENT_SIZE,
+    crossover,
+    mutate,
+    project_to_feasible,
+    seeded_python_random,
+    to_individuals,
+)
 from .planner import BasePlanner
 from .selection import duplicates
 

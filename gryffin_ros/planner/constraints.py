@@ -7,9 +7,10 @@ Constraint plugins are factories ``(options: dict) -> constraint`` registered un
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib.metadata import entry_points
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -37,7 +38,7 @@ def expression_constraint(options: Mapping[str, Any], names: Sequence[str]) -> N
 
 
 def flow_reactor_constraint(options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
-    """The flow limits of the C60 flow reactor: min_total < F_C + F_S < max_total and each flow below ratio x the other."""
+    """Flow limits of the C60 reactor: min_total < F_C + F_S < max_total, and each flow below ratio x the other."""
     allowed = {"min_total", "max_total", "ratio", "c60_flow", "sultine_flow"}
     unknown = set(options) - allowed
     if unknown:
@@ -115,7 +116,7 @@ class KnownConstraints:
 
     @classmethod
     def build(cls, space: SearchSpace, specs: Sequence[Any] = (),
-              callables: Callable | Sequence[Callable] | None = None) -> "KnownConstraints":
+              callables: Callable | Sequence[Callable] | None = None) -> KnownConstraints:
         constraints = [constraint_from_spec(s, i, space.names) for i, s in enumerate(specs)]
         if callables is not None:
             fns = [callables] if callable(callables) else list(callables)

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import ast
 import operator
-from typing import Any, Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
+from typing import Any
 
 import numpy as np
 

@@ -9,8 +9,8 @@ towards the feasible parent until ||delta||_inf < 1 % of the range, then the chi
 from __future__ import annotations
 
 import random
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Iterator
 
 import numpy as np
 from deap import base, creator, tools

@@ -4,7 +4,8 @@ Every observation k (plus its mirrored copies near continuous bounds) contribute
 Continuous dims: a Gaussian with precision tau ~ Gamma(a = 12 rho^2, 1) (rho = n / V_C). Averaged over that prior
 the Gaussian becomes a Student-t with 2a >= 24 degrees of freedom and scale 1/sqrt(a); we use its Gaussian limit
 (precision a), which differs only in far tails where the uniform term of the acquisition dominates, and which lets
-all squared distances come from one matrix product instead of an (M, N, D) tensor. Finite dims: concrete (Gumbel-softmax) draws with temperature 0.5 + 10/rho,
+all squared distances come from one matrix product instead of an (M, N, D) tensor. Finite dims: concrete
+(Gumbel-softmax) draws with temperature 0.5 + 10/rho,
 reshaped by descriptor distance, averaged over draws into one probability table per dim.
 """
 

@@ -10,9 +10,10 @@ from __future__ import annotations
 import math
 import secrets
 import uuid
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import torch
@@ -150,8 +151,8 @@ class BasePlanner:
                 names = {o.name for o in self.objectives}
                 unknown = set(item) - set(self.space.names) - names - {"experiment_id"}
                 if unknown:
-                    raise ObservationError(f"unknown key(s) {sorted(unknown)}; parameters are {list(self.space.names)}, "
-                                           f"objectives {sorted(names)}")
+                    raise ObservationError(f"unknown key(s) {sorted(unknown)}; parameters are "
+                                           f"{list(self.space.names)}, objectives {sorted(names)}")
                 params = {k: item[k] for k in self.space.names if k in item}
                 objectives = {k: item.get(k) for k in names}
                 experiment_id, meta = item.get("experiment_id"), {}
@@ -237,7 +238,7 @@ class BasePlanner:
         points, strategies = self._propose(n, rng)
         self._ask_count += 1
         proposals = []
-        for x, strategy, params in zip(points, strategies, self.space.to_params(points)):
+        for _x, strategy, params in zip(points, strategies, self.space.to_params(points)):
             proposal = Proposal(str(uuid.uuid4()), params, strategy)
             self.pending[proposal.experiment_id] = proposal
             proposals.append(proposal)
@@ -292,7 +293,7 @@ class BasePlanner:
         }
 
     @classmethod
-    def from_state(cls, state: Mapping[str, Any], known_constraints: ConstraintArg = None) -> "BasePlanner":
+    def from_state(cls, state: Mapping[str, Any], known_constraints: ConstraintArg = None) -> BasePlanner:
         if not isinstance(state, Mapping) or state.get("format") != STATE_FORMAT:
             raise ConfigError(f"not a planner state of format {STATE_FORMAT}")
         if state.get("strategy") != cls.__name__:

@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -185,7 +186,7 @@ class SearchSpace:
         self._index = {p.name: {o: i for i, o in enumerate(p.options)} for p in parameters if p.kind != "continuous"}
 
     @classmethod
-    def from_config(cls, specs: Any) -> "SearchSpace":
+    def from_config(cls, specs: Any) -> SearchSpace:
         if not isinstance(specs, (list, tuple)):
             raise ConfigError("'parameters' must be a list of parameter definitions")
         return cls([parameter_from_spec(spec, i) for i, spec in enumerate(specs)])
@@ -246,17 +247,14 @@ class SearchSpace:
 
     def to_params(self, X: np.ndarray) -> list[dict[str, Any]]:
         """(M, D) internal array -> list of parameter dicts in users' units, as plain Python types."""
-        rows = []
-        for x in np.atleast_2d(X):
-            row: dict[str, Any] = {}
-            for d, p in enumerate(self.parameters):
-                if p.kind == "continuous":
-                    row[p.name] = float(min(p.high, max(p.low, p.low + float(x[d]) * p.span)))
-                else:
-                    option = p.options[int(round(float(x[d])))]
-                    row[p.name] = option if p.kind == "categorical" else (int(option) if p.integer else float(option))
-            rows.append(row)
-        return rows
+        columns = self.columns(np.atleast_2d(X))
+        values = []
+        for p in self.parameters:
+            column = columns[p.name]
+            if p.kind == "discrete" and p.integer:
+                column = column.astype(int)
+            values.append(column.tolist())
+        return [dict(zip(self.names, row)) for row in zip(*values)]
 
     def columns(self, X: np.ndarray) -> dict[str, np.ndarray]:
         """Column arrays in users' units (categorical as object arrays of option names), for vectorized constraints."""

@@ -7,8 +7,16 @@ import numpy as np
 import pytest
 import yaml
 
-from gryffin_ros.planner import (ConfigError, ConstraintError, ExhaustedSpaceError, Genetic, NoFeasiblePointError,
-                                 ObservationError, Planner, Random)
+from gryffin_ros.planner import (
+    ConfigError,
+    ConstraintError,
+    ExhaustedSpaceError,
+    Genetic,
+    NoFeasiblePointError,
+    ObservationError,
+    Planner,
+    Random,
+)
 from tests.conftest import branin, branin_feasible
 
 

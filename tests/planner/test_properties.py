@@ -61,6 +61,29 @@ def objective_against(texts, checks, numeric):
     return lambda p: -sum(w * p[k] for k, w in weights.items())
 
 
+def feasible_fraction(specs, checks, samples=4000, seed=0):
+    """The feasible fraction measured independently of the planner, by uniform sampling in users' units."""
+    rng = np.random.default_rng(seed)
+    columns = {}
+    for spec in specs:
+        if spec["type"] == "continuous":
+            columns[spec["name"]] = rng.uniform(spec["low"], spec["high"], samples).tolist()
+        elif spec["type"] == "discrete":
+            columns[spec["name"]] = rng.integers(spec["low"], spec["high"] + 1, samples).tolist()
+        else:
+            columns[spec["name"]] = rng.choice(spec["options"], samples).tolist()
+    rows = [dict(zip(columns, values)) for values in zip(*columns.values())]
+    return np.mean([all(check(row) for check in checks) for row in rows])
+
+
+def assert_clear_refusal(exc, specs, checks):
+    """Running out of new points, or a feasible set too small to sample, may end a campaign; nothing else may."""
+    name = type(exc).__name__
+    assert name in ("ExhaustedSpaceError", "NoFeasiblePointError"), exc
+    if name == "NoFeasiblePointError":
+        assert feasible_fraction(specs, checks) < 0.01, exc
+
+
 def assert_valid(specs, checks, params):
     assert set(params) == {s["name"] for s in specs}
     for spec in specs:
@@ -75,7 +98,7 @@ def assert_valid(specs, checks, params):
         assert check(params), params
 
 
-@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=30, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(problem=problems(), optimizer=st.sampled_from(["adam", "genetic"]), seed=st.integers(0, 2**31))
 def test_planner_proposals_are_always_feasible_in_bounds_and_typed(problem, optimizer, seed):
     specs, texts, checks, objective = problem
@@ -86,8 +109,8 @@ def test_planner_proposals_are_always_feasible_in_bounds_and_typed(problem, opti
     for _ in range(5):
         try:
             proposals = planner.ask(2)
-        except Exception as exc:  # a finite space may run out of new feasible points; nothing else may fail
-            assert type(exc).__name__ == "ExhaustedSpaceError", exc
+        except Exception as exc:
+            assert_clear_refusal(exc, specs, checks)
             return
         for proposal in proposals:
             assert_valid(specs, checks, proposal.params)
@@ -95,18 +118,18 @@ def test_planner_proposals_are_always_feasible_in_bounds_and_typed(problem, opti
             planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=15, deadline=None, derandomize=True)
 @given(problem=problems(), seed=st.integers(0, 2**31))
 def test_baseline_proposals_are_always_feasible(problem, seed):
     specs, texts, checks, objective = problem
     config = {"parameters": specs, "objectives": [{"name": "y", "goal": "min"}], "constraints": texts}
     for strategy in (Random, Genetic):
         planner = strategy(config, seed=seed)
-        for i in range(25):
+        for _i in range(25):
             try:
                 (proposal,) = planner.ask()
             except Exception as exc:
-                assert type(exc).__name__ == "ExhaustedSpaceError", exc
+                assert_clear_refusal(exc, specs, checks)
                 break
             assert_valid(specs, checks, proposal.params)
             planner.tell({**proposal.params, "y": objective(proposal.params), "experiment_id": proposal.experiment_id})
