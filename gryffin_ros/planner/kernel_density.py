@@ -5,8 +5,8 @@ Continuous dims: a Gaussian with precision tau ~ Gamma(a = 12 rho^2, 1) (rho = n
 the Gaussian becomes a Student-t with 2a >= 24 degrees of freedom and scale 1/sqrt(a); we use its Gaussian limit
 (precision a), which differs only in far tails where the uniform term of the acquisition dominates, and which lets
 all squared distances come from one matrix product instead of an (M, N, D) tensor. Finite dims: concrete
-(Gumbel-softmax) draws with temperature 0.5 + 10/rho,
-reshaped by descriptor distance, averaged over draws into one probability table per dim.
+(Gumbel-softmax) draws with temperature 0.5 + 10/rho, reshaped by descriptor distance, averaged over draws into one
+probability table per dim.
 """
 
 from __future__ import annotations
