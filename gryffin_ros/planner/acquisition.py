@@ -42,14 +42,18 @@ class Acquisition:
     def _chunk(self, xc: torch.Tensor, xf: torch.Tensor, with_grad: bool) -> tuple[torch.Tensor, torch.Tensor]:
         """alpha (M,) and d alpha / d xc (M, C) (zeros unless with_grad) for one chunk of points."""
         density = self.density
+        alpha = torch.full((len(xc),), self.strategy, dtype=DTYPE)
+        grad = torch.zeros_like(xc)
         with torch.no_grad():
             dense = density.log_kernels(xc, xf)  # (M, N)
-            shift = torch.clamp_min(dense.amax(dim=1), density.log_uniform)
-            alpha = self._alpha(dense, shift)
+            largest = dense.amax(dim=1)
+            shift = torch.clamp_min(largest, density.log_uniform)
             # rows where some kernel is within CUTOFF of the largest term; elsewhere alpha = s and the gradient is 0
-            live = torch.nonzero((dense > (shift - CUTOFF)[:, None]).any(dim=1)).flatten()
-        grad = torch.zeros_like(xc)
-        if with_grad and xc.shape[1] and len(live):
+            live = torch.nonzero(largest > shift - CUTOFF).flatten()
+            if not len(live):
+                return alpha, grad
+            alpha[live] = self._alpha(dense[live], shift[live])
+        if with_grad and xc.shape[1]:
             leaf = xc[live].clone().requires_grad_(True)
             value = self._alpha(density.log_kernels(leaf, xf[live]), shift[live])
             (grad[live],) = torch.autograd.grad(value.sum(), leaf)

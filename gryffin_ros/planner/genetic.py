@@ -133,7 +133,8 @@ class GeneticOptimizer:
         with seeded_python_random(rng):
             for _ in range(self.generations):
                 elites = tools.selBest(population, n_elite)
-                parents = np.array(tools.selTournament(population, len(population) - n_elite, TOURNAMENT_SIZE))
+                selected = tools.selTournament(population, len(population) - n_elite, TOURNAMENT_SIZE)
+                parents = np.array(selected)
                 if not len(parents):
                     break
                 children = parents.copy()
@@ -147,9 +148,12 @@ class GeneticOptimizer:
                 if mutating.any():
                     before = children[mutating]
                     children[mutating] = project_to_feasible(self.constraints, mutate(space, before, rng), before)
+                # only children that differ from their parent need alpha again
+                fitness = np.array([p.fitness.values[0] for p in selected])
+                changed = np.flatnonzero((children != parents).any(axis=1))
+                fitness[changed] = acquisition.evaluate(children[changed])
                 elite_fitness = [e.fitness.values[0] for e in elites]
-                population = (to_individuals(children, acquisition.evaluate(children))
-                              + to_individuals(np.array(elites), elite_fitness))
+                population = to_individuals(children, fitness) + to_individuals(np.array(elites), elite_fitness)
                 X = np.array(population)
                 if (np.ptp(space.scaled(X), axis=0) < CONVERGED_SPAN).all():
                     break

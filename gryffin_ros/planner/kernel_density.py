@@ -103,14 +103,16 @@ class KernelDensity:
     def log_kernels(self, xc: torch.Tensor, xf: torch.Tensor) -> torch.Tensor:
         """xc: (M, C) continuous coords (may require grad), xf: (M, F) long option indices -> (M, N) log p_k(x)."""
         M = xc.shape[0] if xc.shape[1] else xf.shape[0]
-        out = torch.zeros((M, self.n_kernels), dtype=DTYPE)
         if xc.shape[1]:
+            # log_norm - prec/2 |x - mu|^2 = prec x.mu + (log_norm - prec/2 |x|^2) - prec/2 |mu|^2, in two passes
             x = xc[:, self._ordinary]
-            sq = (x ** 2).sum(1, keepdim=True) - 2.0 * x @ self.loc.T + self._loc_sq[None]  # (M, N)
+            out = torch.addmm(-0.5 * self.precision * self._loc_sq[None], x, self.loc.T, alpha=self.precision)
+            out = out + (self._log_norm - 0.5 * self.precision * (x ** 2).sum(1, keepdim=True))
             if self._periodic.numel():
                 diff = xc[:, self._periodic][:, None, :] - self.loc_periodic[None]
-                sq = sq + ((diff - torch.round(diff)) ** 2).sum(-1)
-            out = out + self._log_norm - 0.5 * self.precision * sq.clamp_min(0.0)
+                out = out - 0.5 * self.precision * ((diff - torch.round(diff)) ** 2).sum(-1)
+        else:
+            out = torch.zeros((M, self.n_kernels), dtype=DTYPE)
         for j, table in enumerate(self.tables):
             out = out + table.T[xf[:, j]]  # (M, N)
         return out
