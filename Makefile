@@ -23,7 +23,7 @@ $(STAMP): setup.py constraints.txt
 venv: $(STAMP)
 
 demo: venv
-	$(VENV)/bin/gryffin-ros demo
+	$(VENV)/bin/gryffin-ros campaign
 
 # Each test run gets its own ROS domain (1-101) so parallel runs on one machine never see each other.
 test: venv

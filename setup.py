@@ -16,11 +16,12 @@ setup(
     python_requires=">=3.10",
     packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
     include_package_data=True,
-    package_data={PACKAGE: ["examples/*.yaml", "resources/*.xml"]},
+    package_data={PACKAGE: ["resources/*.xml", "emulators/data/*"]},
     data_files=[
         (f"share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/msg_schemas", [str(p) for p in Path("msg_schemas").glob("*.json")]),
+        (f"share/{PACKAGE}/examples", [str(p) for p in Path("examples").glob("*.yaml")]),
     ],
     install_requires=[
         "numpy>=1.24",
@@ -28,6 +29,7 @@ setup(
         "deap>=1.4",
         "jsonschema>=4.0",
         "PyYAML>=6.0",
+        "matplotlib>=3.7",
     ],
     extras_require={
         "test": ["pytest>=8", "hypothesis>=6", "ruff>=0.5"],
@@ -36,6 +38,8 @@ setup(
     entry_points={
         "console_scripts": [
             "gryffin-ros = gryffin_ros.cli:main",
+            "planner_node = gryffin_ros.nodes.planner_node:main",
+            "flow_reactor_node = gryffin_ros.nodes.flow_reactor_node:main",
         ],
     },
 )

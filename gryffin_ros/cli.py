@@ -1,53 +1,231 @@
-"""`gryffin-ros` command line: run a constrained campaign from the Python API and print its progress."""
+"""`gryffin-ros`: run a closed-loop flow-reactor campaign (planner node + emulator node over ROS 2, or the Python
+API alone with --no-ros), and export a campaign store to CSV/JSON."""
 
 from __future__ import annotations
 
 import argparse
-import math
+import signal
+import subprocess
 import sys
 import time
-from collections.abc import Sequence
-from importlib import resources
+from pathlib import Path
+from typing import Sequence
 
+from .emulators import FlowReactorEmulator
+from .emulators.flow_reactor import OUTPUTS
+from .paths import share_path
 from .planner import GryffinRosError, Planner
+from .planner.config import PlannerConfig, load_config
+from .rosenv import ros_environment
+from .storage import CampaignStore
+
+STALL_SECONDS = 120.0
 
 
-def toy_flow_yield(params: dict) -> float:
-    """A smooth stand-in for the flow reactor: best near a 1:1.3 flow ratio, ~240 uL/min in total and 135 degC."""
-    total, ratio = params["F_C"] + params["F_S"], params["F_S"] / max(params["F_C"], 1e-9)
-    return (math.exp(-((total - 240.0) / 90.0) ** 2) * math.exp(-(math.log(ratio / 1.3)) ** 2 / 0.2)
-            * math.exp(-((params["T"] - 135.0) / 25.0) ** 2))
+class Progress:
+    """One self-updating terminal line: a bar, experiments done, best so far."""
+
+    def __init__(self, budget: int, objective: str):
+        self.budget, self.objective, self.start = budget, objective, time.monotonic()
+        self.interactive = sys.stdout.isatty()
+        self._last = -1
+
+    def show(self, done: int, best: float | None) -> None:
+        if done == self._last:
+            return
+        self._last = done
+        filled = int(30 * min(done, self.budget) / self.budget)
+        best_text = "-" if best is None else f"{best:.4g}"
+        line = (f"[{'#' * filled}{'.' * (30 - filled)}] {done:4d}/{self.budget} experiments  best {self.objective} "
+                f"{best_text}  ({time.monotonic() - self.start:.1f} s)")
+        print(("\r" + line) if self.interactive else line, end="" if self.interactive else "\n", flush=True)
+
+    def close(self) -> None:
+        if self.interactive:
+            print(flush=True)
 
 
-def demo(args: argparse.Namespace) -> int:
-    config = args.config or resources.files("gryffin_ros").joinpath("examples/flow_reactor_toy.yaml")
-    planner = Planner(str(config), seed=args.seed)
-    objective = planner.objectives[0]
-    print(f"campaign '{planner.config.name}': {planner.space.dim} parameters, feasible fraction "
-          f"{planner.feasible_fraction.value:.3f} ({planner.feasible_fraction.method}), budget {args.budget}")
-    for i in range(1, args.budget + 1):
-        start = time.perf_counter()
-        (proposal,) = planner.ask(1)
-        elapsed = time.perf_counter() - start
-        value = toy_flow_yield(proposal.params)
-        planner.tell({**proposal.params, objective.name: value, "experiment_id": proposal.experiment_id})
-        best = planner.best().objectives[objective.name]
-        shown = "  ".join(f"{k}={v:7.2f}" for k, v in proposal.params.items())
-        print(f"[{i:3d}/{args.budget}] {shown}  -> {objective.name} {value:.3f}  best {best:.3f}  "
-              f"(ask {elapsed:.2f} s)", flush=True)
-    print(f"best: {planner.best().params} -> {planner.best().objectives}")
+def best_value(config: PlannerConfig, store: CampaignStore) -> tuple[int, float | None]:
+    planner = Planner(config, seed=0)
+    planner.tell(store.observations())
+    best = planner.best()
+    return len(planner.observations), None if best is None else best.objectives[config.objectives[0].name]
+
+
+def emulator_settings(config: PlannerConfig) -> tuple[list[str], list[str]]:
+    """The parameter names the emulator reads (C60 flow, sultine flow, T in config order) and the outputs it reports."""
+    names = [p.name for p in config.space.parameters]
+    objectives = [o.name for o in config.objectives]
+    if len(names) != 3 or any(p.kind != "continuous" for p in config.space.parameters):
+        raise GryffinRosError("the flow-reactor emulator needs exactly three continuous parameters: C60 flow, sultine "
+                              "flow and temperature, in that order")
+    unknown = [o for o in objectives if o not in OUTPUTS]
+    if unknown:
+        raise GryffinRosError(f"the flow-reactor emulator reports {list(OUTPUTS)}; objective(s) {unknown} unknown")
+    return names, objectives
+
+
+def run_local(config: PlannerConfig, store: CampaignStore, args: argparse.Namespace, progress: Progress) -> None:
+    """The same campaign through the Python API: planner and emulator in this process, same store."""
+    names, objectives = emulator_settings(config)
+    planner = Planner(config, seed=args.seed)
+    planner.tell(store.observations())
+    emulator = FlowReactorEmulator(seed=args.seed)
+    while len(planner.observations) < args.budget:
+        for proposal in planner.ask():
+            result = emulator.run(*(proposal.params[n] for n in names)).as_dict()
+            observation = planner.tell({"experiment_id": proposal.experiment_id, "params": proposal.params,
+                                        "objectives": {k: result[k] for k in objectives}, "meta": result})[0]
+            store.add_observation(observation)
+            best = planner.best()
+            progress.show(len(planner.observations), best.objectives[objectives[0]] if best else None)
+
+
+def stop(processes: list[subprocess.Popen], env: dict[str, str]) -> None:
+    """SIGINT (clean rclpy shutdown), then SIGTERM, then SIGKILL; shared memory of killed nodes is cleaned."""
+    for process in processes:
+        if process.poll() is None:
+            process.send_signal(signal.SIGINT)
+    killed = False
+    for process in processes:
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.terminate()
+            try:
+                process.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+                killed = True
+    fastdds = Path(sys.executable).with_name("fastdds")
+    if killed and fastdds.exists():
+        subprocess.run([str(fastdds), "shm", "clean"], env=env, capture_output=True, timeout=30)
+
+
+def run_ros(config_path: str, config: PlannerConfig, store: CampaignStore, args: argparse.Namespace,
+            progress: Progress, out: Path) -> None:
+    """Planner node and emulator node as separate processes over DDS on loopback; progress read from the store."""
+    names, objectives = emulator_settings(config)
+    env = ros_environment(domain_id=args.domain_id)
+    env["ROS_LOG_DIR"] = str(out / "ros_logs")
+    seed = args.seed if args.seed is not None else -1
+    planner_cmd = [sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args",
+                   "-p", f"config:={config_path}", "-p", f"storage:={store.path}", "-p", f"seed:={seed}",
+                   "-p", f"acquisition_optimizer:={config.general.acquisition_optimizer}"]
+    emulator_cmd = [sys.executable, "-m", "gryffin_ros.nodes.flow_reactor_node", "--ros-args",
+                    "-p", f"seed:={seed}", "-p", f"experiment_time_s:={args.experiment_time}",
+                    "-p", f"parameters:=[{','.join(names)}]", "-p", f"objectives:=[{','.join(objectives)}]"]
+    logs = [open(out / "planner_node.log", "w"), open(out / "flow_reactor_node.log", "w")]
+    processes = [subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT)
+                 for cmd, log in zip((planner_cmd, emulator_cmd), logs)]
+    try:
+        done, last_change = -1, time.monotonic()
+        while True:
+            count, best = best_value(config, store)
+            progress.show(count, best)
+            if count >= args.budget:
+                return
+            if count != done:
+                done, last_change = count, time.monotonic()
+            for process, log in zip(processes, logs):
+                if process.poll() is not None:
+                    raise GryffinRosError(f"{Path(log.name).stem} exited with code {process.returncode}; see "
+                                          f"{log.name}")
+            if time.monotonic() - last_change > STALL_SECONDS:
+                raise GryffinRosError(f"no new observation for {STALL_SECONDS:.0f} s; see the logs in {out}")
+            time.sleep(0.1)
+    finally:
+        stop(processes, env)
+        for log in logs:
+            log.close()
+
+
+def plot(store: CampaignStore, config: PlannerConfig, path: Path) -> None:
+    """Best-so-far trace of each objective against the experiment number."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    observations = store.observations()
+    fig, axes = plt.subplots(1, len(config.objectives), figsize=(5 * len(config.objectives), 3.6), squeeze=False)
+    for ax, objective in zip(axes[0], config.objectives):
+        best, trace = None, []
+        for o in observations:
+            value = o.objectives.get(objective.name)
+            if value is not None and (best is None or (value > best if objective.goal == "max" else value < best)):
+                best = value
+            trace.append(float("nan") if best is None else best)
+        ax.plot(range(1, len(trace) + 1), trace, drawstyle="steps-post", color="tab:blue")
+        ax.set_xlabel("experiment")
+        ax.set_ylabel(f"best {objective.name} ({objective.goal})")
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"campaign '{config.name}': best so far")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def campaign(args: argparse.Namespace) -> int:
+    config_path = str(Path(args.config).resolve()) if args.config else str(share_path("examples") / "flow_reactor.yaml")
+    config = load_config(config_path)
+    out = Path(args.out) if args.out else Path.cwd() / f"campaign-{config.name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    out.mkdir(parents=True, exist_ok=True)
+    store = CampaignStore(out / "campaign.sqlite", config.raw, config.hash)
+    progress = Progress(args.budget, config.objectives[0].name)
+    print(f"campaign '{config.name}' ({config_path}), budget {args.budget}, "
+          f"{'Python API' if args.no_ros else 'planner node + flow-reactor emulator node over ROS 2'}; output {out}")
+    interrupted = False
+    try:
+        if args.no_ros:
+            run_local(config, store, args, progress)
+        else:
+            run_ros(config_path, config, store, args, progress, out)
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        progress.close()
+        rows = store.export_csv(out / "experiments.csv")
+        if rows:
+            plot(store, config, out / "best_so_far.png")
+        store.close()
+    count = rows
+    print(f"{count} experiment(s): {out / 'experiments.csv'}, {out / 'best_so_far.png'}, {out / 'campaign.sqlite'}")
+    return 130 if interrupted else 0
+
+
+def export(args: argparse.Namespace) -> int:
+    store = CampaignStore.open_existing(args.store)
+    if not args.csv and not args.json:
+        raise GryffinRosError("give --csv FILE and/or --json FILE")
+    if args.csv:
+        print(f"{store.export_csv(args.csv)} observation(s) written to {args.csv}")
+    if args.json:
+        print(f"{store.export_json(args.json)} observation(s) written to {args.json}")
+    store.close()
     return 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="gryffin-ros", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("demo", help="run a constrained toy campaign through the Python API")
-    run.add_argument("--config", help="campaign config (YAML/JSON); default: the packaged flow-reactor toy")
+    run = sub.add_parser("campaign", help="run a closed-loop flow-reactor campaign (default: the packaged example)")
+    run.add_argument("--config", help="campaign config (YAML/JSON); default: examples/flow_reactor.yaml")
     run.add_argument("--budget", type=int, default=30, help="number of experiments (default 30)")
-    run.add_argument("--seed", type=int, default=0)
-    run.set_defaults(handler=demo)
+    run.add_argument("--out", help="output folder (default: a new campaign-<name>-<time> folder here)")
+    run.add_argument("--seed", type=int, default=None, help="seed of planner and emulator (default random)")
+    run.add_argument("--experiment-time", type=float, default=0.0, help="emulated seconds per experiment")
+    run.add_argument("--domain-id", type=int, default=None, help="ROS_DOMAIN_ID (default: from the environment)")
+    run.add_argument("--no-ros", action="store_true", help="run planner and emulator in this process, no ROS")
+    run.set_defaults(handler=campaign)
+    exp = sub.add_parser("export", help="write a campaign store's experiments as CSV and/or JSON")
+    exp.add_argument("store", help="campaign SQLite file")
+    exp.add_argument("--csv", help="CSV file to write")
+    exp.add_argument("--json", help="JSON file to write")
+    exp.set_defaults(handler=export)
     args = parser.parse_args(argv)
+    if getattr(args, "budget", 1) < 1:
+        parser.error("--budget must be at least 1")
     try:
         return args.handler(args)
     except GryffinRosError as exc:

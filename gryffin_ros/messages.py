@@ -1,0 +1,84 @@
+"""The wire contract: JSON Schemas of msg_schemas/ loaded once, validation of every payload in and out, and the
+conversions between JSON payloads and domain objects. No ROS here, so the CLI and tests use it too.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from functools import lru_cache
+from typing import Any
+
+import jsonschema
+
+from .paths import share_path
+from .planner.errors import GryffinRosError
+from .planner.planner import Observation, Proposal
+
+SCHEMAS = ("observation", "proposals", "event", "status", "error")
+# Larger messages are refused before they are parsed.
+MAX_MESSAGE_BYTES = 1 << 20
+
+
+class MessageError(GryffinRosError):
+    """A payload is not valid JSON or does not follow its schema."""
+
+
+@lru_cache(maxsize=None)
+def validator(name: str) -> jsonschema.protocols.Validator:
+    schema = json.loads((share_path("msg_schemas") / f"{name}.schema.json").read_text())
+    cls = jsonschema.validators.validator_for(schema)
+    cls.check_schema(schema)
+    return cls(schema)
+
+
+def _reject_constant(value: str) -> None:
+    raise ValueError(f"{value} is not valid JSON")
+
+
+def parse(name: str, text: str) -> Any:
+    """Parse and validate an incoming payload; raises MessageError with a reason a sender can act on."""
+    if len(text.encode("utf-8", errors="replace")) > MAX_MESSAGE_BYTES:
+        raise MessageError(f"message larger than {MAX_MESSAGE_BYTES} bytes")
+    try:
+        document = json.loads(text, parse_constant=_reject_constant)
+    except (ValueError, RecursionError) as exc:
+        raise MessageError(f"malformed JSON: {exc}") from None
+    check(name, document)
+    return document
+
+
+def check(name: str, document: Any) -> None:
+    error = jsonschema.exceptions.best_match(validator(name).iter_errors(document))
+    if error is not None:
+        where = "/".join(str(p) for p in error.absolute_path) or "(root)"
+        raise MessageError(f"{name} message invalid at {where}: {error.message}")
+
+
+def dump(name: str, document: Any) -> str:
+    """Validate an outgoing payload and serialize it (a failure here is a bug of ours, not the sender's)."""
+    check(name, document)
+    return json.dumps(document, allow_nan=False)
+
+
+def finite_or_none(value: Any) -> Any:
+    return None if isinstance(value, float) and not math.isfinite(value) else value
+
+
+def proposals_message(campaign: str, proposals: list[Proposal], n_observations: int) -> str:
+    return dump("proposals", {"campaign": campaign, "proposals": [p.to_dict() for p in proposals],
+                              "n_observations": n_observations, "created": time.time()})
+
+
+def observation_items(document: Any) -> list[dict]:
+    """An observation payload is one observation or a list of them."""
+    return document if isinstance(document, list) else [document]
+
+
+def observation_message(observation: Observation) -> dict:
+    out = {"experiment_id": observation.experiment_id, "params": observation.params,
+           "objectives": {k: finite_or_none(v) for k, v in observation.objectives.items()}}
+    if observation.meta:
+        out["meta"] = observation.meta
+    return out

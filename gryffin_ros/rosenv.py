@@ -1,0 +1,29 @@
+"""The process environment every rclpy process of this project runs with: DDS discovery on loopback only, the
+fast-discovery Fast DDS profile, and a ROS domain of its own when the caller has not chosen one."""
+
+from __future__ import annotations
+
+import os
+from importlib import resources
+from typing import Mapping
+
+
+def profile_path() -> str:
+    return str(resources.files("gryffin_ros").joinpath("resources/fastdds_profile.xml"))
+
+
+def ros_environment(base: Mapping[str, str] | None = None, domain_id: int | None = None) -> dict[str, str]:
+    env = dict(os.environ if base is None else base)
+    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    env.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", profile_path())
+    env.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
+    if domain_id is not None:
+        env["ROS_DOMAIN_ID"] = str(domain_id)
+    else:
+        env.setdefault("ROS_DOMAIN_ID", str(os.getpid() % 101 + 1))
+    return env
+
+
+def apply_to_this_process() -> None:
+    """Set the loopback-only environment in this process before rclpy initializes."""
+    os.environ.update(ros_environment())

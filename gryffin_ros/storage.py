@@ -1,0 +1,170 @@
+"""The campaign store: one SQLite file (WAL) holding the config and its hash, every proposal and every observation
+(with the raw message it came in). The only module that touches the database.
+
+An observation is committed before this module returns, so a caller that acknowledges after ``add_observation`` never
+acknowledges something a crash could lose.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import sqlite3
+import threading
+import time
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Iterable, Iterator
+
+from .planner.errors import GryffinRosError
+from .planner.planner import Observation, Proposal
+
+SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS proposals (
+    experiment_id TEXT PRIMARY KEY, params TEXT NOT NULL, strategy REAL, created REAL NOT NULL);
+CREATE TABLE IF NOT EXISTS observations (
+    seq INTEGER PRIMARY KEY AUTOINCREMENT, experiment_id TEXT NOT NULL UNIQUE, params TEXT NOT NULL,
+    objectives TEXT NOT NULL, meta TEXT NOT NULL, raw TEXT, received REAL NOT NULL);
+"""
+
+
+class StoreError(GryffinRosError):
+    """The campaign store cannot be used (another campaign's file, unreadable, duplicate experiment)."""
+
+
+class CampaignStore:
+    def __init__(self, path: str | Path, config: dict, config_hash: str):
+        self.path = str(path)
+        self._lock = threading.Lock()
+        try:
+            self._db = sqlite3.connect(self.path, check_same_thread=False, isolation_level=None, timeout=30.0)
+            if self.path != ":memory:":
+                self._db.execute("PRAGMA journal_mode=WAL")
+            self._db.execute("PRAGMA synchronous=FULL")
+            self._db.executescript(SCHEMA)
+        except sqlite3.DatabaseError as exc:
+            raise StoreError(f"cannot open campaign store '{self.path}': {exc}") from None
+        stored = self.get_meta("config_hash")
+        if stored is None:
+            with self._transaction():
+                self._set_meta("config", json.dumps(config, sort_keys=True))
+                self._set_meta("config_hash", config_hash)
+                self._set_meta("created", repr(time.time()))
+        elif stored != config_hash:
+            raise StoreError(
+                f"campaign store '{self.path}' belongs to a different config (stored hash {stored[:12]}, this config "
+                f"{config_hash[:12]}); use another storage file, or the config it was started with")
+
+    @classmethod
+    def open_existing(cls, path: str | Path) -> "CampaignStore":
+        """Open a store written earlier, with the config it holds."""
+        if not Path(path).is_file():
+            raise StoreError(f"no campaign store at '{path}'")
+        try:
+            with sqlite3.connect(f"file:{path}?mode=ro", uri=True) as db:
+                rows = dict(db.execute("SELECT key, value FROM meta WHERE key IN ('config', 'config_hash')"))
+        except sqlite3.DatabaseError as exc:
+            raise StoreError(f"'{path}' is not a campaign store: {exc}") from None
+        if set(rows) != {"config", "config_hash"}:
+            raise StoreError(f"'{path}' is not a campaign store (no config recorded)")
+        return cls(path, json.loads(rows["config"]), rows["config_hash"])
+
+    # ---- low level -------------------------------------------------------------------------------------------
+    @contextmanager
+    def _transaction(self) -> Iterator[None]:
+        with self._lock:
+            self._db.execute("BEGIN IMMEDIATE")
+            try:
+                yield
+            except BaseException:
+                self._db.execute("ROLLBACK")
+                raise
+            self._db.execute("COMMIT")
+
+    def _set_meta(self, key: str, value: str) -> None:
+        self._db.execute("INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)", (key, value))
+
+    def _query(self, sql: str, args: tuple = ()) -> list[tuple]:
+        with self._lock:
+            return self._db.execute(sql, args).fetchall()
+
+    def get_meta(self, key: str) -> str | None:
+        rows = self._query("SELECT value FROM meta WHERE key = ?", (key,))
+        return rows[0][0] if rows else None
+
+    def set_meta(self, key: str, value: str) -> None:
+        with self._transaction():
+            self._set_meta(key, value)
+
+    def close(self) -> None:
+        with self._lock:
+            self._db.close()
+
+    # ---- campaign data ---------------------------------------------------------------------------------------
+    def add_proposals(self, proposals: Iterable[Proposal]) -> None:
+        now = time.time()
+        with self._transaction():
+            self._db.executemany(
+                "INSERT INTO proposals (experiment_id, params, strategy, created) VALUES (?, ?, ?, ?)",
+                [(p.experiment_id, json.dumps(p.params), p.strategy, now) for p in proposals])
+
+    def add_observation(self, observation: Observation, raw: str | None = None) -> None:
+        """Commit one observation; a second one with the same experiment_id raises StoreError."""
+        try:
+            with self._transaction():
+                self._db.execute(
+                    "INSERT INTO observations (experiment_id, params, objectives, meta, raw, received) "
+                    "VALUES (?, ?, ?, ?, ?, ?)",
+                    (observation.experiment_id, json.dumps(observation.params), json.dumps(observation.objectives),
+                     json.dumps(observation.meta), raw, time.time()))
+        except sqlite3.IntegrityError:
+            raise StoreError(f"experiment_id '{observation.experiment_id}' was already reported") from None
+
+    def proposals(self) -> list[Proposal]:
+        rows = self._query("SELECT experiment_id, params, strategy FROM proposals ORDER BY created, rowid")
+        return [Proposal(eid, json.loads(params), strategy) for eid, params, strategy in rows]
+
+    def observations(self) -> list[Observation]:
+        rows = self._query("SELECT experiment_id, params, objectives, meta FROM observations ORDER BY seq")
+        return [Observation(json.loads(p), json.loads(o), eid, json.loads(m)) for eid, p, o, m in rows]
+
+    def pending(self) -> list[Proposal]:
+        """Proposals without an observation yet, oldest first."""
+        reported = {o.experiment_id for o in self.observations()}
+        return [p for p in self.proposals() if p.experiment_id not in reported]
+
+    def count_observations(self) -> int:
+        return self._query("SELECT COUNT(*) FROM observations")[0][0]
+
+    # ---- export ----------------------------------------------------------------------------------------------
+    def rows(self) -> list[dict[str, Any]]:
+        """One flat row per observation: seq, experiment_id, parameters, objectives, then meta values."""
+        out = []
+        for seq, observation in enumerate(self.observations(), start=1):
+            row: dict[str, Any] = {"seq": seq, "experiment_id": observation.experiment_id}
+            row.update(observation.params)
+            row.update({k: ("" if v is None else v) for k, v in observation.objectives.items()})
+            row.update({k: v for k, v in observation.meta.items() if k not in row and not isinstance(v, (dict, list))})
+            out.append(row)
+        return out
+
+    def export_csv(self, path: str | Path) -> int:
+        rows = self.rows()
+        columns: list[str] = []
+        for row in rows:
+            columns.extend(k for k in row if k not in columns)
+        with open(path, "w", newline="") as handle:
+            writer = csv.DictWriter(handle, fieldnames=columns or ["seq", "experiment_id"])
+            writer.writeheader()
+            writer.writerows(rows)
+        return len(rows)
+
+    def export_json(self, path: str | Path) -> int:
+        document = {
+            "config": json.loads(self.get_meta("config") or "{}"),
+            "proposals": [p.to_dict() for p in self.proposals()],
+            "observations": [o.to_dict() for o in self.observations()],
+        }
+        Path(path).write_text(json.dumps(document, indent=2))
+        return len(document["observations"])
