@@ -8,8 +8,8 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 from .emulators import FlowReactorEmulator
 from .emulators.flow_reactor import OUTPUTS

@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import math
 import time
-from functools import lru_cache
+from functools import cache
 from typing import Any
 
 import jsonschema
@@ -25,7 +25,7 @@ class MessageError(GryffinRosError):
     """A payload is not valid JSON or does not follow its schema."""
 
 
-@lru_cache(maxsize=None)
+@cache
 def validator(name: str) -> jsonschema.protocols.Validator:
     schema = json.loads((share_path("msg_schemas") / f"{name}.schema.json").read_text())
     cls = jsonschema.validators.validator_for(schema)

@@ -4,8 +4,8 @@ fast-discovery Fast DDS profile, and a ROS domain of its own when the caller has
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from importlib import resources
-from typing import Mapping
 
 
 def profile_path() -> str:

@@ -12,9 +12,10 @@ import json
 import sqlite3
 import threading
 import time
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Iterable, Iterator
+from typing import Any
 
 from .planner.errors import GryffinRosError
 from .planner.planner import Observation, Proposal
@@ -57,7 +58,7 @@ class CampaignStore:
                 f"{config_hash[:12]}); use another storage file, or the config it was started with")
 
     @classmethod
-    def open_existing(cls, path: str | Path) -> "CampaignStore":
+    def open_existing(cls, path: str | Path) -> CampaignStore:
         """Open a store written earlier, with the config it holds."""
         if not Path(path).is_file():
             raise StoreError(f"no campaign store at '{path}'")

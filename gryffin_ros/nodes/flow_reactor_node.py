@@ -42,7 +42,7 @@ class FlowReactorNode(Node):
         if p["experiment_time_s"] < 0:
             raise GryffinRosError(f"parameter 'experiment_time_s' must be >= 0, got {p['experiment_time_s']}")
         if len(p["parameters"]) != 3:
-            raise GryffinRosError("parameter 'parameters' must name exactly three parameters: C60 flow, sultine flow, T")
+            raise GryffinRosError("parameter 'parameters' must name three parameters: C60 flow, sultine flow, T")
         unknown = set(p["objectives"]) - set(OUTPUTS)
         if unknown or not p["objectives"]:
             raise GryffinRosError(f"parameter 'objectives' must list outputs among {list(OUTPUTS)}, got "

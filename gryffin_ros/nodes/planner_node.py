@@ -85,13 +85,15 @@ class PlannerNode(Node):
         self._state = "idle"
         self._ask_blocked = False
 
-        optimizer_group, io_group = MutuallyExclusiveCallbackGroup(), ReentrantCallbackGroup()
+        # observations one at a time, in arrival order (so events and the store keep that order); status beside
+        optimizer_group, observations_group = MutuallyExclusiveCallbackGroup(), MutuallyExclusiveCallbackGroup()
+        status_group = ReentrantCallbackGroup()
         self.proposals_pub = self.create_publisher(String, "~/proposals", LATCHED_QOS)
         self.events_pub = self.create_publisher(String, "~/events", EVENTS_QOS)
         self.status_pub = self.create_publisher(String, "~/status", LATCHED_QOS)
         self.create_subscription(String, "~/observations", self._on_observation, OBSERVATIONS_QOS,
-                                 callback_group=io_group)
-        self.create_service(Trigger, "~/get_status", self._on_get_status, callback_group=io_group)
+                                 callback_group=observations_group)
+        self.create_service(Trigger, "~/get_status", self._on_get_status, callback_group=status_group)
         self.create_service(Trigger, "~/recommend", self._on_recommend, callback_group=optimizer_group)
         self.create_timer(0.02, self._auto_propose, callback_group=optimizer_group)
         if self._pending:  # after a restart, the experiments still owed are announced again
@@ -181,6 +183,22 @@ class PlannerNode(Node):
             self._n_failed += observation.failed
             self._ask_blocked = False
         self._event("observation_accepted", experiment_id)
+        # the planner learns it now unless it is busy optimizing; then right after (never block on it here)
+        if self._planner_lock.acquire(blocking=False):
+            try:
+                self._absorb()
+            finally:
+                self._planner_lock.release()
+
+    def _absorb(self) -> None:
+        """Tell the planner the observations accepted since last time (caller holds the planner lock)."""
+        with self._state_lock:
+            inbox, self._inbox = self._inbox, []
+        if inbox:
+            self.planner.tell(inbox)
+            best = self.planner.best()
+            with self._state_lock:
+                self._best = best
 
     def _on_get_status(self, request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
         response.success, response.message = True, messages.dump("status", self.status())
@@ -190,12 +208,10 @@ class PlannerNode(Node):
     def _propose(self) -> list[Proposal]:
         with self._planner_lock:
             with self._state_lock:
-                inbox, self._inbox = self._inbox, []
                 self._state = "optimizing"
             self._publish_status()
             try:
-                if inbox:
-                    self.planner.tell(inbox)
+                self._absorb()
                 proposals = self.planner.ask(self.batch_size)
                 self.store.add_proposals(proposals)
                 self.store.set_meta("ask_count", str(self.planner.state()["ask_count"]))
@@ -211,8 +227,8 @@ class PlannerNode(Node):
                 raise exc
             with self._state_lock:
                 self._pending.update(p.experiment_id for p in proposals)
-                self._best = self.planner.best()
                 self._state = "idle"
+            self._absorb()  # what arrived while optimizing
         self._event("proposals_ready", reason=f"{len(proposals)} proposal(s) after "
                                               f"{len(self.planner.observations)} observation(s)")
         self._publish_status()
@@ -259,8 +275,9 @@ def main(args: list[str] | None = None) -> int:
         pass
     finally:
         executor.shutdown()
+        with node._planner_lock:  # an optimizer callback still running finishes its writes first
+            node.store.close()
         node.destroy_node()
-        node.store.close()
         rclpy.try_shutdown()
     return 0
 

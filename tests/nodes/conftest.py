@@ -1,0 +1,182 @@
+"""Real ROS 2: the planner node runs in its own process; the test process talks to it over DDS on loopback.
+
+Every test run uses its own ROS_DOMAIN_ID (set by `make test`, else derived from the pid) and
+ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST with the fast-discovery profile.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from gryffin_ros.rosenv import ros_environment
+
+os.environ.update(ros_environment())  # before rclpy is initialized in this process
+
+import rclpy  # noqa: E402
+from rclpy.executors import SingleThreadedExecutor  # noqa: E402
+from rclpy.node import Node  # noqa: E402
+from std_msgs.msg import String  # noqa: E402
+from std_srvs.srv import Trigger  # noqa: E402
+
+from gryffin_ros.nodes.qos import EVENTS_QOS, LATCHED_QOS, OBSERVATIONS_QOS  # noqa: E402
+
+PLUGIN_PATH = Path(__file__).resolve().parents[1] / "plugin_package"
+FLOW_CONFIG = {
+    "name": "flow_test",
+    "parameters": [{"name": "F_C", "type": "continuous", "low": 0.0, "high": 200.0},
+                   {"name": "F_S", "type": "continuous", "low": 0.0, "high": 200.0},
+                   {"name": "T", "type": "continuous", "low": 100.0, "high": 150.0}],
+    "objectives": [{"name": "X1_X2", "goal": "max"}],
+    "constraints": [{"plugin": "flow_reactor"}],
+}
+
+
+def flow_feasible(p: dict) -> bool:
+    return 30 < p["F_C"] + p["F_S"] < 310 and p["F_C"] < 2 * p["F_S"] and p["F_S"] < 2 * p["F_C"]
+
+
+class Client(Node):
+    """The lab side: publishes observations, records events/status/proposals, calls the services."""
+
+    def __init__(self) -> None:
+        super().__init__("test_lab_client")
+        self.events: list[dict] = []
+        self.proposals: list[dict] = []
+        self.lock = threading.Lock()
+        self.publisher = self.create_publisher(String, "/gryffin_planner/observations", OBSERVATIONS_QOS)
+        self.create_subscription(String, "/gryffin_planner/events", self._record(self.events), EVENTS_QOS)
+        self.create_subscription(String, "/gryffin_planner/proposals", self._record(self.proposals), LATCHED_QOS)
+        self.recommend_client = self.create_client(Trigger, "/gryffin_planner/recommend")
+        self.status_client = self.create_client(Trigger, "/gryffin_planner/get_status")
+
+    def _record(self, sink: list):
+        def callback(msg: String) -> None:
+            with self.lock:
+                sink.append(json.loads(msg.data))
+        return callback
+
+    def call(self, client, timeout: float = 30.0) -> Trigger.Response:
+        assert client.wait_for_service(timeout_sec=timeout), f"service {client.srv_name} not available"
+        future = client.call_async(Trigger.Request())
+        deadline = time.monotonic() + timeout
+        while not future.done():
+            assert time.monotonic() < deadline, f"no answer from {client.srv_name}"
+            time.sleep(0.01)
+        return future.result()
+
+    def status(self) -> dict:
+        return json.loads(self.call(self.status_client).message)
+
+    def recommend(self) -> Trigger.Response:
+        return self.call(self.recommend_client)
+
+    def wait_matched(self, timeout: float = 10.0) -> None:
+        deadline = time.monotonic() + timeout
+        while self.publisher.get_subscription_count() == 0:
+            assert time.monotonic() < deadline, "planner's observation subscription never matched"
+            time.sleep(0.02)
+
+    def publish(self, payload) -> None:
+        self.publisher.publish(String(data=payload if isinstance(payload, str) else json.dumps(payload)))
+
+    def wait_events(self, count: int, timeout: float = 15.0) -> list[dict]:
+        deadline = time.monotonic() + timeout
+        while True:
+            with self.lock:
+                observed = [e for e in self.events if e["type"].startswith("observation_")]
+            if len(observed) >= count:
+                return observed
+            assert time.monotonic() < deadline, f"expected {count} observation events, got {observed}"
+            time.sleep(0.02)
+
+    def wait_proposals(self, count: int, timeout: float = 30.0) -> list[dict]:
+        deadline = time.monotonic() + timeout
+        while True:
+            with self.lock:
+                if len(self.proposals) >= count:
+                    return list(self.proposals)
+            assert time.monotonic() < deadline, f"expected {count} proposals messages, got {self.proposals}"
+            time.sleep(0.02)
+
+
+@pytest.fixture
+def client(lab_session):
+    """The session's lab client with nothing recorded yet (messages of earlier tests' nodes are dropped)."""
+    with lab_session.lock:
+        lab_session.events.clear()
+        lab_session.proposals.clear()
+    return lab_session
+
+
+@pytest.fixture(scope="session")
+def lab_session():
+    rclpy.init()
+    node = Client()
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    thread = threading.Thread(target=executor.spin, daemon=True)
+    thread.start()
+    yield node
+    executor.shutdown()
+    node.destroy_node()
+    rclpy.try_shutdown()
+
+
+def node_env(tmp_path: Path) -> dict[str, str]:
+    env = ros_environment()
+    env["ROS_LOG_DIR"] = str(tmp_path / "ros_logs")
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(PLUGIN_PATH), env.get("PYTHONPATH")]))
+    return env
+
+
+class PlannerProcess:
+    def __init__(self, tmp_path: Path, config: dict, **params):
+        self.config_path = tmp_path / f"config-{len(list(tmp_path.glob('config-*')))}.yaml"
+        self.config_path.write_text(yaml.safe_dump(config))
+        params.setdefault("storage", str(tmp_path / "campaign.sqlite"))
+        params.setdefault("seed", 0)
+        args = ["--ros-args", "-p", f"config:={self.config_path}"]
+        for key, value in params.items():
+            args += ["-p", f"{key}:={str(value).lower() if isinstance(value, bool) else value}"]
+        self.log_path = tmp_path / "planner.log"
+        self.log = open(self.log_path, "a")
+        self.process = subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.planner_node", *args],
+                                        env=node_env(tmp_path), stdout=self.log, stderr=subprocess.STDOUT)
+
+    def output(self) -> str:
+        self.log.flush()
+        return self.log_path.read_text()
+
+    def stop(self) -> int:
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+            try:
+                self.process.wait(timeout=15)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+        self.log.close()
+        return self.process.returncode
+
+
+@pytest.fixture
+def start_planner(tmp_path):
+    started: list[PlannerProcess] = []
+
+    def start(config: dict = FLOW_CONFIG, **params) -> PlannerProcess:
+        process = PlannerProcess(tmp_path, config, **params)
+        started.append(process)
+        return process
+    yield start
+    for process in started:
+        process.stop()

@@ -1,0 +1,138 @@
+"""The planner node over real DDS: services, observation events, restart on the same store, plugins."""
+
+import json
+import sqlite3
+import subprocess
+import sys
+import time
+
+from gryffin_ros import messages
+
+from .conftest import FLOW_CONFIG, flow_feasible, node_env
+
+
+def observation(proposal, value=0.5, **changes):
+    return {"experiment_id": proposal["experiment_id"], "params": {**proposal["params"], **changes},
+            "objectives": {"X1_X2": value}}
+
+
+def stored_ids(path):
+    with sqlite3.connect(path) as db:
+        return [row[0] for row in db.execute("SELECT experiment_id FROM observations ORDER BY seq")]
+
+
+def test_recommend_round_trip_and_observation_accepted(client, start_planner, tmp_path):
+    start_planner(auto_propose=False)
+    response = client.recommend()
+    assert response.success, response.message
+    document = json.loads(response.message)
+    messages.check("proposals", document)
+    (proposal,) = document["proposals"]
+    assert flow_feasible(proposal["params"])
+    client.wait_matched()
+    before = len(client.wait_events(0))
+    client.publish(observation(proposal))
+    event = client.wait_events(before + 1)[-1]
+    assert event == {"type": "observation_accepted", "experiment_id": proposal["experiment_id"]}
+    status = client.status()
+    messages.check("status", status)
+    assert (status["n_observations"], status["n_pending"]) == (1, 0)
+    assert stored_ids(tmp_path / "campaign.sqlite") == [proposal["experiment_id"]]
+
+
+def test_every_bad_observation_gets_a_specific_reason_and_nothing_is_stored(client, start_planner, tmp_path):
+    start_planner(auto_propose=False)
+    first, second = (json.loads(client.recommend().message)["proposals"][0] for _ in range(2))
+    client.wait_matched()
+    bad = [
+        ("{not json", "malformed JSON"),
+        ({"experiment_id": "x", "params": {"F_C": 1}}, "objectives"),
+        (observation(first, F_X=3.0), "unknown parameter(s) ['F_X']"),
+        (observation(first, T=180.0), "'T' = 180.0 is above its upper bound 150.0"),
+        (observation(first, F_C=150.0, F_S=10.0), "violate the known constraint"),
+        ({**observation(first), "experiment_id": "never-proposed"}, "unknown experiment_id 'never-proposed'"),
+        ({**observation(first), "objectives": {"X1_X2": "high"}}, "invalid at objectives/X1_X2"),
+    ]
+    start = len(client.wait_events(0))
+    for payload, _ in bad:
+        client.publish(payload)
+    client.publish(observation(first))
+    client.publish(observation(first, value=0.9))  # duplicate: the first report stands
+    client.publish(observation(second, value=None) | {"objectives": None})  # a failed experiment is data
+    events = client.wait_events(start + len(bad) + 3)[start:]
+    for (payload, reason), event in zip(bad, events):
+        assert event["type"] == "observation_rejected", (payload, event)
+        assert reason in event["reason"], (reason, event)
+    assert events[len(bad)]["type"] == "observation_accepted", events[len(bad)]
+    assert events[len(bad) + 1]["type"] == "observation_rejected"
+    assert "already reported" in events[len(bad) + 1]["reason"]
+    assert events[len(bad) + 2]["type"] == "observation_accepted"
+    status = client.status()
+    assert (status["n_observations"], status["n_failed"], status["n_pending"]) == (2, 1, 0)
+    assert stored_ids(tmp_path / "campaign.sqlite") == [first["experiment_id"], second["experiment_id"]]
+    assert client.recommend().success  # still serving
+
+
+def test_restart_on_the_same_store_resumes_and_refuses_another_config(client, start_planner, tmp_path):
+    planner = start_planner(auto_propose=False)
+    proposals = [json.loads(client.recommend().message)["proposals"][0] for _ in range(4)]
+    client.wait_matched()
+    start = len(client.wait_events(0))
+    for proposal in proposals[:3]:
+        client.publish(observation(proposal, value=0.3))
+    client.wait_events(start + 3)
+    assert planner.stop() == 0
+    start_planner(auto_propose=False)
+    deadline = time.monotonic() + 30
+    while True:  # the old node's service may still be discovered for a moment
+        status = client.status()
+        if status["n_pending"] == 1 or time.monotonic() > deadline:
+            break
+        time.sleep(0.1)
+    assert (status["n_observations"], status["n_pending"]) == (3, 1)
+    client.publish(observation(proposals[3], value=0.8))
+    client.wait_events(start + 4)
+    assert client.status()["best"]["objectives"] == {"X1_X2": 0.8}
+    other = {**FLOW_CONFIG, "constraints": ["F_C + F_S <= 100"]}
+    refused = start_planner(other, auto_propose=False)
+    assert refused.process.wait(timeout=60) == 2
+    assert "different config" in refused.output()
+
+
+def test_auto_propose_publishes_the_next_batch_when_all_have_reported(client, start_planner):
+    start_planner(batch_size=2)
+    latest = client.wait_proposals(1)[-1]
+    assert len(latest["proposals"]) == 2
+    client.wait_matched()
+    for proposal in latest["proposals"]:
+        client.publish(observation(proposal))
+    following = client.wait_proposals(2)[-1]
+    assert following["n_observations"] == 2
+    assert {p["experiment_id"] for p in following["proposals"]}.isdisjoint(
+        {p["experiment_id"] for p in latest["proposals"]})
+
+
+def test_third_party_plugin_loads_and_a_raising_plugin_is_reported(client, start_planner):
+    config = {**FLOW_CONFIG, "constraints": [{"plugin": "test_max_sum", "options": {"names": ["F_C", "F_S"],
+                                                                                  "limit": 60}}]}
+    start_planner(config, auto_propose=False)
+    for _ in range(3):
+        (proposal,) = json.loads(client.recommend().message)["proposals"]
+        assert proposal["params"]["F_C"] + proposal["params"]["F_S"] <= 60
+    planner = start_planner({**FLOW_CONFIG, "name": "exploding", "constraints": [{"plugin": "test_exploding"}]},
+                            auto_propose=False, storage="\":memory:\"")
+    assert planner.process.wait(timeout=60) == 2  # V_C is estimated at start-up: the broken plugin stops it there
+    assert "'test_exploding' raised RuntimeError: interlock controller unreachable" in planner.output()
+
+
+def test_bad_start_up_parameters_exit_with_a_message(tmp_path):
+    env = node_env(tmp_path)
+    result = subprocess.run([sys.executable, "-m", "gryffin_ros.nodes.planner_node"], env=env, capture_output=True,
+                            text=True, timeout=60)
+    assert result.returncode == 2 and "parameter 'config' is required" in result.stderr
+    config = tmp_path / "contradiction.json"
+    config.write_text(json.dumps({**FLOW_CONFIG, "constraints": ["F_C < 10", "F_C > 20"]}))
+    result = subprocess.run([sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-p",
+                             f"config:={config}", "-p", "storage:=\":memory:\""], env=env, capture_output=True,
+                            text=True, timeout=60)
+    assert result.returncode == 2 and "no point satisfying the known constraints" in result.stderr

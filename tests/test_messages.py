@@ -1,0 +1,40 @@
+"""The wire contract: every schema is valid, its examples pass, and bad payloads get specific reasons."""
+
+import json
+
+import pytest
+
+from gryffin_ros import messages
+from gryffin_ros.paths import share_path
+
+
+@pytest.mark.parametrize("name", messages.SCHEMAS)
+def test_schema_examples_validate(name):
+    schema = json.loads((share_path("msg_schemas") / f"{name}.schema.json").read_text())
+    assert schema["examples"], f"{name} schema has no example"
+    for example in schema["examples"]:
+        messages.check(name, example)
+
+
+@pytest.mark.parametrize("text, reason", [
+    ("[1, 2", "malformed JSON"),
+    ('{"experiment_id": "a", "params": {"x": NaN}, "objectives": null}', "NaN is not valid JSON"),
+    ('{"experiment_id": "a", "params": {"x": 1}}', "'objectives' is a required property"),
+    ('{"experiment_id": "a", "params": {"x": [1]}, "objectives": null}', "invalid at params/x"),
+    ('{"experiment_id": "a", "params": {"x": 1}, "objectives": null, "extra": 1}', "'extra' was unexpected"),
+    ("[]", "invalid"),
+])
+def test_bad_observation_payloads_are_refused_with_a_reason(text, reason):
+    with pytest.raises(messages.MessageError) as info:
+        messages.parse("observation", text)
+    assert reason in str(info.value)
+
+
+def test_oversized_message_is_refused_before_parsing():
+    with pytest.raises(messages.MessageError, match="larger than"):
+        messages.parse("observation", '"' + "x" * (messages.MAX_MESSAGE_BYTES + 1) + '"')
+
+
+def test_outgoing_payloads_are_checked_too():
+    with pytest.raises(messages.MessageError):
+        messages.dump("event", {"type": "something_else"})
