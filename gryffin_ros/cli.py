@@ -82,11 +82,11 @@ def run_local(config: PlannerConfig, store: CampaignStore, args: argparse.Namesp
 
 
 def stop(processes: list[subprocess.Popen], env: dict[str, str]) -> None:
-    """SIGINT (clean rclpy shutdown), then SIGTERM, then SIGKILL; shared memory of killed nodes is cleaned."""
+    """SIGINT (clean rclpy shutdown), then SIGTERM, then SIGKILL; then Fast DDS shared memory left by dead
+    participants is removed (a node interrupted mid-callback sometimes leaves some even when it exits cleanly)."""
     for process in processes:
         if process.poll() is None:
             process.send_signal(signal.SIGINT)
-    killed = False
     for process in processes:
         try:
             process.wait(timeout=10)
@@ -97,9 +97,8 @@ def stop(processes: list[subprocess.Popen], env: dict[str, str]) -> None:
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
-                killed = True
     fastdds = Path(sys.executable).with_name("fastdds")
-    if killed and fastdds.exists():
+    if fastdds.exists():
         subprocess.run([str(fastdds), "shm", "clean"], env=env, capture_output=True, timeout=30)
 
 

@@ -2,12 +2,13 @@
 
 import csv
 import json
-import os
+import re
 import signal
 import sqlite3
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 from gryffin_ros.rosenv import ros_environment
 
@@ -26,7 +27,8 @@ def test_closed_loop_campaign_over_ros(tmp_path):
     out = tmp_path / "run"
     result = gryffin_ros("campaign", "--budget", "12", "--seed", "4", "--out", str(out))
     assert result.returncode == 0, result.stdout + result.stderr
-    assert "12/12 experiments" in result.stdout
+    done = [int(n) for n in re.findall(r"(\d+)/12 experiments", result.stdout)]
+    assert done and done[-1] >= 12
     rows = list(csv.DictReader(open(out / "experiments.csv")))
     assert len(rows) >= 12
     assert all(flow_feasible(row) for row in rows)
@@ -44,8 +46,15 @@ def test_campaign_without_ros_uses_the_same_store_format(tmp_path):
     assert len(rows) == 8 and all(flow_feasible(row) for row in rows)
 
 
+def zombie_shm_segments() -> int:
+    """`fastdds shm clean` removes the shared memory of dead participants and says how much it removed."""
+    tool = Path(sys.executable).with_name("fastdds")
+    output = subprocess.run([str(tool), "shm", "clean"], capture_output=True, text=True, timeout=60).stdout
+    return sum(int(m) for m in re.findall(r"(\d+) zombie (?:ports|segments) cleaned", output))
+
+
 def test_ctrl_c_stops_both_nodes_and_keeps_the_results(tmp_path):
-    before = set(os.listdir("/dev/shm"))
+    zombie_shm_segments()  # what crashed runs left before this test is not this test's business
     process = subprocess.Popen([sys.executable, "-m", "gryffin_ros.cli", "campaign", "--budget", "500",
                                 "--experiment-time", "0.05", "--out", str(tmp_path)], stdout=subprocess.PIPE,
                                stderr=subprocess.STDOUT, text=True, env=ros_environment())
@@ -56,12 +65,11 @@ def test_ctrl_c_stops_both_nodes_and_keeps_the_results(tmp_path):
     process.send_signal(signal.SIGINT)
     output, _ = process.communicate(timeout=60)
     assert process.returncode == 130, output
-    assert (tmp_path / "experiments.csv").exists()
-    fast_dds = ("fastrtps", "sem.fastrtps", "fast_datasharing")
-    leftovers = {n for n in set(os.listdir("/dev/shm")) - before if n.startswith(fast_dds)}
-    assert not leftovers
+    rows = list(csv.DictReader(open(tmp_path / "experiments.csv")))
+    assert len(rows) == _observations(tmp_path) > 0
     children = subprocess.run(["pgrep", "-f", f"storage:={tmp_path}"], capture_output=True, text=True).stdout
     assert children.strip() == ""
+    assert zombie_shm_segments() == 0  # nothing left in /dev/shm by the nodes
 
 
 def _observations(path):

@@ -9,9 +9,7 @@ import time
 from collections import deque
 
 import numpy as np
-import rclpy
 from rcl_interfaces.msg import ParameterDescriptor
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from std_msgs.msg import String
 
@@ -19,8 +17,8 @@ from .. import messages
 from ..emulators import FlowReactorEmulator
 from ..emulators.flow_reactor import OUTPUTS
 from ..planner import GryffinRosError
-from ..rosenv import apply_to_this_process
 from .qos import LATCHED_QOS, OBSERVATIONS_QOS
+from .runner import run
 
 PARAMETERS = {
     "experiment_time_s": (0.0, "simulated duration of one experiment, in seconds"),
@@ -94,22 +92,7 @@ class FlowReactorNode(Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    apply_to_this_process()
-    rclpy.init(args=args)
-    try:
-        node = FlowReactorNode()
-    except GryffinRosError as exc:
-        print(f"flow_reactor_emulator: cannot start: {exc}", file=sys.stderr)
-        rclpy.try_shutdown()
-        return 2
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return run(FlowReactorNode, "flow_reactor_emulator", args)
 
 
 if __name__ == "__main__":

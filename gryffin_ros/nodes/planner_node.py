@@ -12,10 +12,9 @@ import sys
 import threading
 from pathlib import Path
 
-import rclpy
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from std_msgs.msg import String
 from std_srvs.srv import Trigger
@@ -23,9 +22,9 @@ from std_srvs.srv import Trigger
 from .. import messages
 from ..planner import GryffinRosError, Observation, Planner, Proposal
 from ..planner.config import load_config, read_config
-from ..rosenv import apply_to_this_process
 from ..storage import CampaignStore, StoreError
 from .qos import EVENTS_QOS, LATCHED_QOS, OBSERVATIONS_QOS
+from .runner import run
 
 PARAMETERS = {
     "config": ("", "path to the campaign config (YAML or JSON; Gryffin format accepted); required"),
@@ -258,28 +257,13 @@ class PlannerNode(Node):
         return response
 
 
+def close_store(node: PlannerNode) -> None:
+    with node._planner_lock:  # an optimizer callback still running finishes its writes first
+        node.store.close()
+
+
 def main(args: list[str] | None = None) -> int:
-    apply_to_this_process()
-    rclpy.init(args=args)
-    try:
-        node = PlannerNode()
-    except GryffinRosError as exc:
-        print(f"gryffin_planner: cannot start: {exc}", file=sys.stderr)
-        rclpy.try_shutdown()
-        return 2
-    executor = MultiThreadedExecutor(num_threads=4)
-    executor.add_node(node)
-    try:
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        executor.shutdown()
-        with node._planner_lock:  # an optimizer callback still running finishes its writes first
-            node.store.close()
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return run(PlannerNode, "gryffin_planner", args, lambda: MultiThreadedExecutor(num_threads=4), close_store)
 
 
 if __name__ == "__main__":
