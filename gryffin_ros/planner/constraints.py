@@ -1,15 +1,17 @@
 """Known constraints: callables, declarative expressions and plugins, combined by AND, plus the feasible fraction V_C.
 
 Constraint plugins are factories ``(options: dict) -> constraint`` registered under the entry-point group
-``gryffin_ros.constraints``; the built-ins ``expression`` and ``flow_reactor`` live here.
+``gryffin_ros.constraints``; the built-ins ``expression``, ``flow_reactor`` and ``lookup`` live here.
 """
 
 from __future__ import annotations
 
+import csv
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib.metadata import entry_points
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -55,7 +57,59 @@ def flow_reactor_constraint(options: Mapping[str, Any], names: Sequence[str]) ->
     return NamedConstraint(f"flow_reactor({text})", expression, expression.evaluate)
 
 
-BUILTIN_PLUGINS = {"expression": expression_constraint, "flow_reactor": flow_reactor_constraint}
+def _lookup_key(value: Any) -> Any:
+    """Membership key of one value: numbers compare by value (1 == 1.0), anything else as its text."""
+    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool):
+        return round(float(value), 9)
+    text = str(value).strip()
+    try:
+        return round(float(text), 9)
+    except ValueError:
+        return text
+
+
+def lookup_constraint(options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
+    """Feasible when the parameters form a row of a CSV of feasible combinations (e.g. synthesizable molecules).
+
+    Options: ``file`` (CSV with a header) and ``columns`` (parameter -> CSV column; default: every parameter, by
+    its own name).
+    """
+    unknown = set(options) - {"file", "columns"}
+    if unknown:
+        raise ConfigError(f"lookup constraint: unknown option(s) {sorted(unknown)}; allowed ['columns', 'file']")
+    path = options.get("file")
+    if not isinstance(path, str) or not path:
+        raise ConfigError("lookup constraint: 'file' must name a CSV file of feasible rows")
+    columns = options.get("columns", {name: name for name in names})
+    if not isinstance(columns, Mapping) or not columns:
+        raise ConfigError("lookup constraint: 'columns' must map parameter names to CSV column names")
+    unknown = set(columns) - set(names)
+    if unknown:
+        raise ConfigError(f"lookup constraint: unknown parameter(s) {sorted(unknown)} in 'columns'")
+    try:
+        with open(path, newline="") as handle:
+            reader = csv.DictReader(handle)
+            missing = set(columns.values()) - set(reader.fieldnames or [])
+            if missing:
+                raise ConfigError(f"lookup constraint: '{path}' has no column(s) {sorted(missing)}")
+            rows = {tuple(_lookup_key(row[columns[n]]) for n in columns) for row in reader}
+    except OSError as exc:
+        raise ConfigError(f"lookup constraint: cannot read '{path}': {exc.strerror}") from None
+    if not rows:
+        raise ConfigError(f"lookup constraint: '{path}' holds no rows")
+    keys = list(columns)
+
+    def evaluate(cols: Mapping[str, np.ndarray]) -> np.ndarray:
+        values = zip(*[[_lookup_key(v) for v in cols[k]] for k in keys])
+        return np.fromiter((row in rows for row in values), dtype=bool, count=len(cols[keys[0]]))
+
+    def member(params: Mapping[str, Any]) -> bool:
+        return tuple(_lookup_key(params[k]) for k in keys) in rows
+    return NamedConstraint(f"lookup({Path(path).name}: {len(rows)} feasible rows)", member, evaluate)
+
+
+BUILTIN_PLUGINS = {"expression": expression_constraint, "flow_reactor": flow_reactor_constraint,
+                   "lookup": lookup_constraint}
 
 
 def load_plugin(name: str, options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:

@@ -94,3 +94,32 @@ def test_contradictory_constraints_give_a_clear_error_not_a_hang():
     c = KnownConstraints.build(SQUARE, ["x0 < 0.2", "x0 > 0.8"])
     with pytest.raises(NoFeasiblePointError, match="no point satisfying the known constraints"):
         estimate_feasible_fraction(c, np.random.default_rng(0), max_samples=100_000)
+
+
+def test_lookup_plugin_accepts_exactly_the_listed_rows(tmp_path):
+    space = SearchSpace.from_config([{"name": "r1", "type": "categorical", "options": ["A", "B", "C"]},
+                                     {"name": "n", "type": "discrete", "low": 1, "high": 3}])
+    table = tmp_path / "feasible.csv"
+    table.write_text("group,count,note\nA,1,x\nB,3.0,y\nC,2,z\n")
+    c = KnownConstraints.build(space, [{"plugin": "lookup", "options": {"file": str(table),
+                                                                        "columns": {"r1": "group", "n": "count"}}}])
+    feasible = {(p["r1"], p["n"]) for p in space.to_params(space.enumerate()) if c.is_feasible(p)}
+    assert feasible == {("A", 1), ("B", 3), ("C", 2)}
+    assert c.feasible(space.enumerate()).sum() == 3
+
+
+@pytest.mark.parametrize("options, message", [
+    ({}, "'file' must name a CSV file"),
+    ({"file": "/nonexistent.csv"}, "cannot read"),
+    ({"file": "TABLE", "columns": {"r9": "group"}}, "unknown parameter(s) ['r9']"),
+    ({"file": "TABLE", "columns": {"r1": "missing"}}, "has no column(s) ['missing']"),
+    ({"file": "TABLE", "sheet": 1}, "unknown option(s) ['sheet']"),
+])
+def test_lookup_plugin_config_errors(tmp_path, options, message):
+    space = SearchSpace.from_config([{"name": "r1", "type": "categorical", "options": ["A", "B"]}])
+    table = tmp_path / "t.csv"
+    table.write_text("group\nA\n")
+    options = {k: (str(table) if v == "TABLE" else v) for k, v in options.items()}
+    with pytest.raises(ConfigError) as info:
+        KnownConstraints.build(space, [{"plugin": "lookup", "options": options}])
+    assert message in str(info.value)
