@@ -26,8 +26,13 @@ GRYFFIN_NO_OP_KEYS = {"num_cpus", "boosted", "caching", "save_database", "verbos
 
 @dataclass(frozen=True)
 class Objective:
+    """One objective; with several, `tolerance` (relative to the observed range, or `absolute` in the objective's
+    units) says how far from its best a point may be and still count as good on it (Chimera)."""
+
     name: str
-    goal: str  # "min" | "max"
+    goal: str = "min"  # "min" | "max"
+    tolerance: float = 0.0
+    absolute: bool = False
 
 
 @dataclass(frozen=True)
@@ -40,12 +45,13 @@ class GeneralSettings:
     feasible_fraction: float | None = None
     random_seed: int | None = None
     max_rejection_draws: int = 1_000_000
+    softness: float = 1e-3
 
 
 _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
     "batches": (int,), "sampling_strategies": (int,), "num_random_samples": (int,),
     "acquisition_optimizer": (str,), "obj_transform": (str,), "feasible_fraction": (int, float),
-    "random_seed": (int,), "max_rejection_draws": (int,),
+    "random_seed": (int,), "max_rejection_draws": (int,), "softness": (int, float),
 }
 _GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"}, "obj_transform": {"sqrt", "identity"}}
 
@@ -111,6 +117,8 @@ def _general(spec: Any) -> GeneralSettings:
     for key in ("batches", "sampling_strategies", "num_random_samples", "max_rejection_draws"):
         if key in values and values[key] < 1:
             raise ConfigError(f"'general.{key}' must be at least 1, got {values[key]}")
+    if "softness" in values and not (values["softness"] >= 0 and math.isfinite(values["softness"])):
+        raise ConfigError(f"'general.softness' must be a non-negative number, got {values['softness']}")
     fraction = values.get("feasible_fraction")
     if fraction is not None and not (0 < fraction <= 1 and math.isfinite(fraction)):
         raise ConfigError(f"'general.feasible_fraction' must be in (0, 1], got {fraction}")
@@ -136,12 +144,17 @@ def _objectives(spec: Any, parameter_names: tuple[str, ...]) -> list[Objective]:
             raise ConfigError(f"objective '{name}' has the same name as a parameter")
         if goal not in ("min", "max", "minimize", "maximize"):
             raise ConfigError(f"objective '{name}': 'goal' must be 'min' or 'max', got {goal!r}")
-        out.append(Objective(name, goal[:3]))
+        tolerance, absolute = item.get("tolerance", 0.0), item.get("absolute", False)
+        if not isinstance(absolute, bool):
+            raise ConfigError(f"objective '{name}': 'absolute' must be true or false, got {absolute!r}")
+        if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float)) or not math.isfinite(tolerance):
+            raise ConfigError(f"objective '{name}': 'tolerance' must be a finite number, got {tolerance!r}")
+        if not absolute and not 0.0 <= tolerance <= 1.0:
+            raise ConfigError(f"objective '{name}': a relative 'tolerance' must be in [0, 1], got {tolerance} "
+                              "(set absolute: true for a tolerance in the objective's units)")
+        out.append(Objective(name, goal[:3], float(tolerance), absolute))
     if len({o.name for o in out}) != len(out):
         raise ConfigError("duplicate objective names")
-    if len(out) > 1:
-        raise ConfigError(f"{len(out)} objectives given: multi-objective optimization (Chimera) is not supported yet; "
-                          "give one objective")
     return out
 
 

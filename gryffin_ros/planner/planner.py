@@ -20,6 +20,7 @@ import torch
 
 from .acquisition import Acquisition
 from .adam_hill import AdamHillOptimizer
+from .chimera import Chimera
 from .config import PlannerConfig, load_config
 from .constraints import FeasibleFraction, KnownConstraints, estimate_feasible_fraction
 from .errors import ConfigError, ExhaustedSpaceError, NoFeasiblePointError, ObservationError
@@ -211,13 +212,17 @@ class BasePlanner:
         return self._internal([p.params for p in self.pending.values()])
 
     def merits(self, observations: Sequence[Observation]) -> np.ndarray:
-        """Objective values as minimization merits in [0, 1] (max goals negated; sqrt transform by default)."""
-        objective = self.objectives[0]
-        y = np.array([o.objectives[objective.name] for o in observations], dtype=float)
-        if objective.goal == "max":
-            y = -y
-        span = y.max() - y.min() if len(y) else 0.0
-        f = (y - y.min()) / span if span > 0 else np.zeros_like(y)
+        """Successful observations -> minimization merits in [0, 1]: one objective rescaled (max goals negated),
+        several scalarized by Chimera; then the objective transform (sqrt by default)."""
+        if not observations:
+            return np.empty(0)
+        Y = np.array([[o.objectives[obj.name] for obj in self.objectives] for o in observations], dtype=float)
+        if len(self.objectives) > 1:
+            f = Chimera(self.objectives, self.config.general.softness).merits(Y)
+        else:
+            y = -Y[:, 0] if self.objectives[0].goal == "max" else Y[:, 0]
+            span = y.max() - y.min()
+            f = (y - y.min()) / span if span > 0 else np.zeros_like(y)
         return np.sqrt(f) if self.config.general.obj_transform == "sqrt" else f
 
     def best(self) -> Observation | None:
