@@ -46,14 +46,18 @@ class GeneralSettings:
     random_seed: int | None = None
     max_rejection_draws: int = 1_000_000
     softness: float = 1e-3
+    feas_approach: str = "fwa"
+    feas_param: float = 1.0
 
 
 _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
     "batches": (int,), "sampling_strategies": (int,), "num_random_samples": (int,),
     "acquisition_optimizer": (str,), "obj_transform": (str,), "feasible_fraction": (int, float),
     "random_seed": (int,), "max_rejection_draws": (int,), "softness": (int, float),
+    "feas_approach": (str,), "feas_param": (int, float),
 }
-_GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"}, "obj_transform": {"sqrt", "identity"}}
+_GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"}, "obj_transform": {"sqrt", "identity"},
+                    "feas_approach": {"fwa", "fia", "fca"}}
 
 
 @dataclass
@@ -119,6 +123,8 @@ def _general(spec: Any) -> GeneralSettings:
             raise ConfigError(f"'general.{key}' must be at least 1, got {values[key]}")
     if "softness" in values and not (values["softness"] >= 0 and math.isfinite(values["softness"])):
         raise ConfigError(f"'general.softness' must be a non-negative number, got {values['softness']}")
+    if "feas_param" in values and not (values["feas_param"] >= 0 and math.isfinite(values["feas_param"])):
+        raise ConfigError(f"'general.feas_param' must be a non-negative number, got {values['feas_param']}")
     fraction = values.get("feasible_fraction")
     if fraction is not None and not (0 < fraction <= 1 and math.isfinite(fraction)):
         raise ConfigError(f"'general.feasible_fraction' must be in (0, 1], got {fraction}")

@@ -77,7 +77,9 @@ class KernelDensity:
     """
 
     def __init__(self, space: SearchSpace, X: np.ndarray, merits: np.ndarray, feasible_fraction: float,
-                 generator: torch.Generator):
+                 generator: torch.Generator, spacing_scaled: bool = False):
+        """spacing_scaled: continuous precision rho^(2/C) (C continuous dims), i.e. kernel width = the typical spacing
+        of rho points in C dims, instead of Gryffin's 12 rho^2 (for the classifier of failed experiments)."""
         self.space = space
         locations, values = mirror(space, X, merits)
         self.n_kernels = len(locations)
@@ -89,7 +91,7 @@ class KernelDensity:
         self.loc_periodic = torch.as_tensor(locations[:, c][:, periodic], dtype=DTYPE)  # (N, P)
         self._ordinary = torch.as_tensor(np.flatnonzero(~periodic))
         self._periodic = torch.as_tensor(np.flatnonzero(periodic))
-        self.precision = 12.0 * self.rho ** 2
+        self.precision = self.rho ** (2.0 / max(len(c), 1)) if spacing_scaled else 12.0 * self.rho ** 2
         self._log_norm = 0.5 * len(c) * math.log(self.precision / (2 * math.pi))
         self._loc_sq = (self.loc ** 2).sum(1)  # (N,)
         temperature = 0.5 + 10.0 / self.rho

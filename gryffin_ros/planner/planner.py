@@ -24,6 +24,7 @@ from .chimera import Chimera
 from .config import PlannerConfig, load_config
 from .constraints import FeasibleFraction, KnownConstraints, estimate_feasible_fraction
 from .errors import ConfigError, ExhaustedSpaceError, NoFeasiblePointError, ObservationError
+from .feasibility import FeasibilityModel, combine
 from .genetic import GeneticOptimizer
 from .kernel_density import KernelDensity
 from .sampling import perturb, rejection_sample
@@ -340,17 +341,46 @@ class Planner(BasePlanner):
             start = np.concatenate([start, feasible_observed])
         return start, False
 
+    def _feasibility(self, observed: np.ndarray, generator: torch.Generator) -> FeasibilityModel | None:
+        """The model of unknown constraints, once some experiment has failed."""
+        failed = np.array([o.failed for o in self.observations])
+        if not failed.any():
+            return None
+        return FeasibilityModel(self.space, observed, failed, self.feasible_fraction.value, generator)
+
+    def _away_from_failures(self, n: int, rng: np.random.Generator, observed: np.ndarray, chosen: np.ndarray,
+                            feasibility: FeasibilityModel) -> np.ndarray:
+        """Nothing has succeeded yet: the feasible candidates most likely to succeed, spread out."""
+        candidates = self.feasible_set()
+        if candidates is None:
+            m = self.config.general.num_random_samples * self.space.dim
+            candidates = rejection_sample(self.constraints, rng, m, self.config.general.max_rejection_draws,
+                                          self.feasible_fraction.value)
+        score = -feasibility.probability(candidates) if len(candidates) else np.empty(0)
+        points = []
+        for _ in range(n):
+            index = select(self.space, candidates, score, observed, chosen) if len(candidates) else None
+            x = candidates[index] if index is not None else self.random_points(
+                1, rng, np.concatenate([observed, chosen]))[0]
+            chosen = np.concatenate([chosen, x[None]])
+            points.append(x)
+        return np.array(points)
+
     def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None]]:
         observed = self.observed_points()
         chosen = self.pending_points()
         successful = [o for o in self.observations if not o.failed]
+        generator = torch.Generator().manual_seed(int(rng.integers(2**63)))
+        feasibility = self._feasibility(observed, generator)
         if not successful:
-            return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n
+            if feasibility is None:
+                return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n
+            return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n
         X = self._internal([o.params for o in successful])
         merits = self.merits(successful)
-        generator = torch.Generator().manual_seed(int(rng.integers(2**63)))
         density = KernelDensity(self.space, X, merits, self.feasible_fraction.value, generator)
         start, exhaustive = self._start_points(rng, X[int(np.argmin(merits))], X)
+        general = self.config.general
         values = self.strategy_values()
         optimizer = self._optimizer()
         refined: dict[float, tuple[np.ndarray, np.ndarray]] = {}
@@ -366,6 +396,9 @@ class Planner(BasePlanner):
                     candidates, alpha = optimizer.optimize(acquisition, start, rng)
                     keep = self.constraints.feasible(candidates)  # guaranteed by the optimizers; never trusted blindly
                     candidates, alpha = candidates[keep], alpha[keep]
+                if feasibility is not None:
+                    alpha = combine(alpha, feasibility.probability(candidates), general.feas_approach,
+                                    general.feas_param, feasibility.fraction_failed)
                 refined[s] = (candidates, alpha)
             candidates, alpha = refined[s]
             index = select(self.space, candidates, alpha, observed, chosen) if len(candidates) else None

@@ -41,7 +41,10 @@ def select(space: SearchSpace, candidates: np.ndarray, alpha: np.ndarray, observ
            chosen: np.ndarray) -> int | None:
     """Index of the best candidate, or None when every candidate duplicates an observed or chosen point."""
     reference = np.concatenate([observed, chosen]) if len(chosen) else observed
-    reward = np.exp(-(alpha - alpha.min()))  # shifted: same argmax, no overflow
+    finite = np.isfinite(alpha)  # +inf marks a candidate that must not be chosen (fca)
+    if not finite.any():
+        return None
+    reward = np.where(finite, np.exp(-(alpha - alpha[finite].min())), 0.0)  # shifted: same argmax, no overflow
     reward[duplicates(space, candidates, reference)] = 0.0
     if not (reward > 0).any():
         return None
