@@ -48,13 +48,14 @@ class GeneralSettings:
     softness: float = 1e-3
     feas_approach: str = "fwa"
     feas_param: float = 1.0
+    auto_desc_gen: bool = False
 
 
 _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
     "batches": (int,), "sampling_strategies": (int,), "num_random_samples": (int,),
     "acquisition_optimizer": (str,), "obj_transform": (str,), "feasible_fraction": (int, float),
     "random_seed": (int,), "max_rejection_draws": (int,), "softness": (int, float),
-    "feas_approach": (str,), "feas_param": (int, float),
+    "feas_approach": (str,), "feas_param": (int, float), "auto_desc_gen": (bool,),
 }
 _GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"}, "obj_transform": {"sqrt", "identity"},
                     "feas_approach": {"fwa", "fia", "fca"}}
@@ -105,15 +106,11 @@ def _general(spec: Any) -> GeneralSettings:
     for key, value in spec.items():
         if key in GRYFFIN_NO_OP_KEYS:
             continue
-        if key == "auto_desc_gen":
-            if value not in (False, None):
-                raise ConfigError("general.auto_desc_gen (dynamic descriptors) is not supported yet; set it to false")
-            continue
         if key not in _GENERAL_TYPES:
             raise ConfigError(f"unknown key 'general.{key}'; known keys: {sorted(_GENERAL_TYPES)}")
         if value is None and key in ("feasible_fraction", "random_seed"):
             continue
-        if isinstance(value, bool) or not isinstance(value, _GENERAL_TYPES[key]):
+        if isinstance(value, bool) != (_GENERAL_TYPES[key] == (bool,)) or not isinstance(value, _GENERAL_TYPES[key]):
             raise ConfigError(f"'general.{key}' has the wrong type: {value!r}")
         if key in _GENERAL_CHOICES and value not in _GENERAL_CHOICES[key]:
             raise ConfigError(f"'general.{key}' must be one of {sorted(_GENERAL_CHOICES[key])}, got {value!r}")

@@ -9,6 +9,8 @@ the same numerics (log space, no underflow) serve both.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import torch
 
@@ -22,11 +24,12 @@ FCA_MIN_PASSING = 0.1
 
 class FeasibilityModel:
     def __init__(self, space: SearchSpace, X: np.ndarray, failed: np.ndarray, feasible_fraction: float,
-                 generator: torch.Generator):
+                 generator: torch.Generator, descriptors: Mapping[int, np.ndarray] | None = None):
         self.fraction_failed = float(failed.mean())
         self.prior = (len(failed) - failed.sum() + 1.0) / (len(failed) + 2.0)
         self._scales = [Acquisition(KernelDensity(space, X, failed.astype(float), feasible_fraction, generator,
-                                                  spacing_scaled=wide), 1.0 - self.prior) for wide in (False, True)]
+                                                  spacing_scaled=wide, descriptors=descriptors), 1.0 - self.prior)
+                        for wide in (False, True)]
 
     def probability(self, X: np.ndarray) -> np.ndarray:
         """(M, D) internal points -> (M,) P(feasible), the lower of two estimates: Gryffin's narrow kernels (sharp

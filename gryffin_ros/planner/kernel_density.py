@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Mapping
 
 import numpy as np
 import torch
@@ -77,9 +78,11 @@ class KernelDensity:
     """
 
     def __init__(self, space: SearchSpace, X: np.ndarray, merits: np.ndarray, feasible_fraction: float,
-                 generator: torch.Generator, spacing_scaled: bool = False):
+                 generator: torch.Generator, spacing_scaled: bool = False,
+                 descriptors: Mapping[int, np.ndarray] | None = None):
         """spacing_scaled: continuous precision rho^(2/C) (C continuous dims), i.e. kernel width = the typical spacing
-        of rho points in C dims, instead of Gryffin's 12 rho^2 (for the classifier of failed experiments)."""
+        of rho points in C dims, instead of Gryffin's 12 rho^2 (for the classifier of failed experiments).
+        descriptors: learned descriptor tables replacing the space's for some finite dims (dynamic descriptors)."""
         self.space = space
         locations, values = mirror(space, X, merits)
         self.n_kernels = len(locations)
@@ -97,7 +100,7 @@ class KernelDensity:
         temperature = 0.5 + 10.0 / self.rho
         self.tables = [
             torch.log(concrete_table(locations[:, d].astype(int), int(space.n_options[d]), temperature,
-                                     space.descriptors(d), generator).clamp_min(1e-300))
+                                     (descriptors or {}).get(d, space.descriptors(d)), generator).clamp_min(1e-300))
             for d in space.finite_idx
         ]  # each (N, K_d)
         self.log_uniform = -space.log_volume

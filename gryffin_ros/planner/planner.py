@@ -23,6 +23,7 @@ from .adam_hill import AdamHillOptimizer
 from .chimera import Chimera
 from .config import PlannerConfig, load_config
 from .constraints import FeasibleFraction, KnownConstraints, estimate_feasible_fraction
+from .descriptors import LearnedDescriptors, learn_descriptors
 from .errors import ConfigError, ExhaustedSpaceError, NoFeasiblePointError, ObservationError
 from .feasibility import FeasibilityModel, combine
 from .genetic import GeneticOptimizer
@@ -341,12 +342,44 @@ class Planner(BasePlanner):
             start = np.concatenate([start, feasible_observed])
         return start, False
 
+    def learned_descriptors(self, X: np.ndarray, target: np.ndarray) -> dict[int, LearnedDescriptors]:
+        """Dynamic descriptors for each categorical dim with several descriptors (general.auto_desc_gen)."""
+        if not self.config.general.auto_desc_gen:
+            return {}
+        learned = {}
+        for d in self.space.finite_idx:
+            table = self.space.descriptors(d)
+            if self.space.parameters[d].kind == "categorical" and table is not None and table.shape[1] > 1:
+                result = learn_descriptors(table, X[:, d].astype(int), target)
+                if result is not None:
+                    learned[int(d)] = result
+        return learned
+
+    def descriptor_summary(self) -> dict[str, dict[str, Any]]:
+        """What dynamic descriptors learned from the current data, per categorical parameter: for the objective
+        model and for the failure model, the relevance of each original descriptor (shares summing to 1) and the
+        correlation of each generated descriptor with its target (kept when above 1/sqrt(N - 2))."""
+        successful = [o for o in self.observations if not o.failed]
+        observed = self.observed_points()
+        models = {"objective": self.learned_descriptors(self._internal([o.params for o in successful]),
+                                                        self.merits(successful)) if successful else {},
+                  "feasibility": self.learned_descriptors(observed, np.array([float(o.failed)
+                                                                              for o in self.observations]))}
+        summary: dict[str, dict[str, Any]] = {}
+        for target, learned in models.items():
+            for d, result in learned.items():
+                summary.setdefault(self.space.names[d], {})[target] = {
+                    "relevance": result.relevance.round(4).tolist(),
+                    "correlations": result.correlations.round(4).tolist(), "kept": result.kept.tolist()}
+        return summary
+
     def _feasibility(self, observed: np.ndarray, generator: torch.Generator) -> FeasibilityModel | None:
         """The model of unknown constraints, once some experiment has failed."""
         failed = np.array([o.failed for o in self.observations])
         if not failed.any():
             return None
-        return FeasibilityModel(self.space, observed, failed, self.feasible_fraction.value, generator)
+        descriptors = {d: r.table for d, r in self.learned_descriptors(observed, failed.astype(float)).items()}
+        return FeasibilityModel(self.space, observed, failed, self.feasible_fraction.value, generator, descriptors)
 
     def _away_from_failures(self, n: int, rng: np.random.Generator, observed: np.ndarray, chosen: np.ndarray,
                             feasibility: FeasibilityModel) -> np.ndarray:
@@ -378,7 +411,9 @@ class Planner(BasePlanner):
             return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n
         X = self._internal([o.params for o in successful])
         merits = self.merits(successful)
-        density = KernelDensity(self.space, X, merits, self.feasible_fraction.value, generator)
+        descriptors = {d: r.table for d, r in self.learned_descriptors(X, merits).items()}
+        density = KernelDensity(self.space, X, merits, self.feasible_fraction.value, generator,
+                                descriptors=descriptors)
         start, exhaustive = self._start_points(rng, X[int(np.argmin(merits))], X)
         general = self.config.general
         values = self.strategy_values()
