@@ -74,7 +74,7 @@ def node_latencies(calls: int, workdir: Path) -> tuple[list[float], list[float]]
             sent = time.perf_counter()
             publisher.publish(String(data=json.dumps({"experiment_id": proposal["experiment_id"],
                                                       "params": proposal["params"],
-                                                      "objectives": {"X1_X2": 0.5 + 0.01 * i}})))
+                                                      "objectives": {"X1_X2": 0.5 + 0.01 * i, "cost": 0.01}})))
             while proposal["experiment_id"] not in events:
                 arrived.wait(timeout=1.0)
                 arrived.clear()

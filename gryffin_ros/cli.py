@@ -23,21 +23,21 @@ STALL_SECONDS = 120.0
 
 
 class Progress:
-    """One self-updating terminal line: a bar, experiments done, best so far."""
+    """One self-updating terminal line: a bar, experiments done, the best experiment's objectives."""
 
-    def __init__(self, budget: int, objective: str):
-        self.budget, self.objective, self.start = budget, objective, time.monotonic()
+    def __init__(self, budget: int):
+        self.budget, self.start = budget, time.monotonic()
         self.interactive = sys.stdout.isatty()
         self._last = -1
 
-    def show(self, done: int, best: float | None) -> None:
+    def show(self, done: int, best: dict[str, float] | None) -> None:
         if done == self._last:
             return
         self._last = done
         filled = int(30 * min(done, self.budget) / self.budget)
-        best_text = "-" if best is None else f"{best:.4g}"
-        line = (f"[{'#' * filled}{'.' * (30 - filled)}] {done:4d}/{self.budget} experiments  best {self.objective} "
-                f"{best_text}  ({time.monotonic() - self.start:.1f} s)")
+        best_text = "-" if best is None else "  ".join(f"{k} {v:.4g}" for k, v in best.items())
+        line = (f"[{'#' * filled}{'.' * (30 - filled)}] {done:4d}/{self.budget} experiments  best: {best_text}  "
+                f"({time.monotonic() - self.start:.1f} s)")
         print(("\r" + line) if self.interactive else line, end="" if self.interactive else "\n", flush=True)
 
     def close(self) -> None:
@@ -45,11 +45,12 @@ class Progress:
             print(flush=True)
 
 
-def best_value(config: PlannerConfig, store: CampaignStore) -> tuple[int, float | None]:
+def best_value(config: PlannerConfig, store: CampaignStore) -> tuple[int, dict[str, float] | None]:
+    """Experiments so far and the objectives of the best one (by the campaign's merit, Chimera included)."""
     planner = Planner(config, seed=0)
     planner.tell(store.observations())
     best = planner.best()
-    return len(planner.observations), None if best is None else best.objectives[config.objectives[0].name]
+    return len(planner.observations), None if best is None else best.objectives
 
 
 def emulator_settings(config: PlannerConfig) -> tuple[list[str], list[str]]:
@@ -78,7 +79,7 @@ def run_local(config: PlannerConfig, store: CampaignStore, args: argparse.Namesp
                                         "objectives": {k: result[k] for k in objectives}, "meta": result})[0]
             store.add_observation(observation)
             best = planner.best()
-            progress.show(len(planner.observations), best.objectives[objectives[0]] if best else None)
+            progress.show(len(planner.observations), best.objectives if best else None)
 
 
 def stop(processes: list[subprocess.Popen], env: dict[str, str]) -> None:
@@ -171,7 +172,7 @@ def campaign(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path.cwd() / f"campaign-{config.name}-{time.strftime('%Y%m%d-%H%M%S')}"
     out.mkdir(parents=True, exist_ok=True)
     store = CampaignStore(out / "campaign.sqlite", config.raw, config.hash)
-    progress = Progress(args.budget, config.objectives[0].name)
+    progress = Progress(args.budget)
     print(f"campaign '{config.name}' ({config_path}), budget {args.budget}, "
           f"{'Python API' if args.no_ros else 'planner node + flow-reactor emulator node over ROS 2'}; output {out}")
     interrupted = False

@@ -1,10 +1,12 @@
 """Unknown constraints learned from failed experiments: P(feasible | x) from the kernel densities of successful and
 failed observations, and its combination with the acquisition (fwa, fia, fca).
 
-P(feasible | x) = (sum_{k ok} p_k(x) + pi * u) / (sum_k p_k(x) + u), where u = 1/V is the uniform density acting as one
-prior pseudo-observation and pi = (n_ok + 1) / (n + 2) the smoothed prior. Far from every observation P = pi; near
-failures P -> 0. This is 1 - alpha of the kernel acquisition with merits = failure labels and strategy s = 1 - pi, so
-the same numerics (log space, no underflow) serve both.
+Two kernel estimates, each P = (sum_{k ok} p_k(x) + prior * u) / (sum_k p_k(x) + u), u = 1/V the uniform density
+acting as one prior pseudo-observation. The wide one (kernels as broad as the spacing of the data, descriptors
+shared between options) has the constant prior pi = (n_ok + 1) / (n + 2); the narrow one (Gryffin's kernels, each
+option on its own) has the wide estimate as its prior. Near observations the narrow kernels decide, between them
+the wide ones extend what was seen, far from everything P = pi. Each estimate is 1 - alpha of the kernel
+acquisition with the failure labels as merits, so the same numerics (log space, no underflow) serve both.
 """
 
 from __future__ import annotations
@@ -22,20 +24,29 @@ APPROACHES = ("fwa", "fia", "fca")
 FCA_MIN_PASSING = 0.1
 
 
+def no_descriptors(space: SearchSpace) -> dict[int, None]:
+    """Descriptor overrides that make every finite dim's kernel treat each option on its own."""
+    return {int(d): None for d in space.finite_idx}
+
+
 class FeasibilityModel:
     def __init__(self, space: SearchSpace, X: np.ndarray, failed: np.ndarray, feasible_fraction: float,
                  generator: torch.Generator, descriptors: Mapping[int, np.ndarray] | None = None):
         self.fraction_failed = float(failed.mean())
         self.prior = (len(failed) - failed.sum() + 1.0) / (len(failed) + 2.0)
-        self._scales = [Acquisition(KernelDensity(space, X, failed.astype(float), feasible_fraction, generator,
-                                                  spacing_scaled=wide, descriptors=descriptors), 1.0 - self.prior)
-                        for wide in (False, True)]
+        labels = failed.astype(float)
+        self._wide = Acquisition(KernelDensity(space, X, labels, feasible_fraction, generator, spacing_scaled=True,
+                                               descriptors=descriptors), 1.0 - self.prior)
+        narrow = KernelDensity(space, X, labels, feasible_fraction, generator, descriptors=no_descriptors(space))
+        self._narrow = (Acquisition(narrow, 0.0), Acquisition(narrow, 1.0))
 
     def probability(self, X: np.ndarray) -> np.ndarray:
-        """(M, D) internal points -> (M,) P(feasible), the lower of two estimates: Gryffin's narrow kernels (sharp
-        near the observations) and kernels as wide as the data spacing (which extend a failed region beyond its
-        failed points)."""
-        return 1.0 - np.maximum(*[scale.evaluate(X) for scale in self._scales])
+        """(M, D) internal points -> (M,) P(feasible): Gryffin's narrow kernels, each option on its own, with the
+        wide estimate (kernels as wide as the data spacing, descriptors shared) as their prior instead of a constant:
+        near observations the narrow kernels decide, elsewhere the wide ones extend what was seen."""
+        prior = 1.0 - self._wide.evaluate(X)
+        alpha0, alpha1 = (a.evaluate(X) for a in self._narrow)  # S_fail/(S+u) and (S_fail+u)/(S+u)
+        return 1.0 - alpha0 - (1.0 - prior) * (alpha1 - alpha0)
 
 
 def combine(alpha: np.ndarray, p_feasible: np.ndarray, approach: str, feas_param: float,
