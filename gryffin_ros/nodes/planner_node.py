@@ -94,11 +94,13 @@ class PlannerNode(Node):
                                  callback_group=observations_group)
         self.create_service(Trigger, "~/get_status", self._on_get_status, callback_group=status_group)
         self.create_service(Trigger, "~/recommend", self._on_recommend, callback_group=optimizer_group)
-        self.create_timer(0.02, self._auto_propose, callback_group=optimizer_group)
+        # auto-propose runs when woken (start-up, an accepted observation) instead of polling with a timer
+        self._wake = self.create_guard_condition(self._auto_propose, callback_group=optimizer_group)
         if self._pending:  # after a restart, the experiments still owed are announced again
             self._publish(self.proposals_pub, messages.proposals_message(
                 self.campaign, list(self.planner.pending.values()), len(self.planner.observations)))
         self._publish_status()
+        self._wake.trigger()
         self.get_logger().info(
             f"campaign '{self.campaign}' in {storage}: {len(self._reported)} observation(s), {len(self._pending)} "
             f"pending; feasible fraction {fraction.value:.3g} ({fraction.method}); seed {seed}")
@@ -182,6 +184,7 @@ class PlannerNode(Node):
             self._n_failed += observation.failed
             self._ask_blocked = False
         self._event("observation_accepted", experiment_id)
+        self._wake.trigger()
         # the planner learns it now unless it is busy optimizing; then right after (never block on it here)
         if self._planner_lock.acquire(blocking=False):
             try:
