@@ -39,7 +39,8 @@ setup(
         "console_scripts": [
             "gryffin-ros = gryffin_ros.cli:main",
             "planner_node = gryffin_ros.nodes.planner_node:main",
-            "flow_reactor_node = gryffin_ros.nodes.flow_reactor_node:main",
+            "flow_reactor_node = gryffin_ros.nodes.emulator_node:flow_reactor_main",
+            "redox_node = gryffin_ros.nodes.emulator_node:redox_main",
         ],
     },
 )

@@ -1,5 +1,5 @@
-"""`gryffin-ros`: run a closed-loop flow-reactor campaign (planner node + emulator node over ROS 2, or the Python
-API alone with --no-ros), and export a campaign store to CSV/JSON."""
+"""`gryffin-ros`: run a closed-loop campaign — flow reactor or redox candidates — with the planner node and an
+emulator node over ROS 2 (or the Python API alone with --no-ros), and export a campaign store to CSV/JSON."""
 
 from __future__ import annotations
 
@@ -11,8 +11,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from .emulators import FlowReactorEmulator
-from .emulators.flow_reactor import OUTPUTS
+from .emulators import FlowReactorEmulator, RedoxEmulator
 from .paths import share_path
 from .planner import GryffinRosError, Planner
 from .planner.config import PlannerConfig, load_config
@@ -53,28 +52,35 @@ def best_value(config: PlannerConfig, store: CampaignStore) -> tuple[int, dict[s
     return len(planner.observations), None if best is None else best.objectives
 
 
-def emulator_settings(config: PlannerConfig) -> tuple[list[str], list[str]]:
-    """The parameter names the emulator reads (C60 flow, sultine flow, T in config order) and the outputs it reports."""
+def emulator_settings(config: PlannerConfig) -> tuple[str, list[str], list[str]]:
+    """Which emulator fits the config ('flow_reactor' or 'redox'), its parameter names and the reported objectives."""
     names = [p.name for p in config.space.parameters]
     objectives = [o.name for o in config.objectives]
-    if len(names) != 3 or any(p.kind != "continuous" for p in config.space.parameters):
-        raise GryffinRosError("the flow-reactor emulator needs exactly three continuous parameters: C60 flow, sultine "
-                              "flow and temperature, in that order")
-    unknown = [o for o in objectives if o not in OUTPUTS]
+    if set(names) == set(RedoxEmulator.parameters):
+        kind, outputs = "redox", RedoxEmulator.outputs
+    elif len(names) == 3 and all(p.kind == "continuous" for p in config.space.parameters):
+        kind, outputs = "flow_reactor", FlowReactorEmulator.outputs
+    else:
+        raise GryffinRosError("no emulator fits this config: the flow reactor needs three continuous parameters (C60 "
+                              f"flow, sultine flow, temperature), the redox lookup the parameters "
+                              f"{list(RedoxEmulator.parameters)}")
+    unknown = [o for o in objectives if o not in outputs]
     if unknown:
-        raise GryffinRosError(f"the flow-reactor emulator reports {list(OUTPUTS)}; objective(s) {unknown} unknown")
-    return names, objectives
+        raise GryffinRosError(f"the {kind} emulator reports {list(outputs)}; objective(s) {unknown} unknown")
+    return kind, names, objectives
 
 
-def run_local(config: PlannerConfig, store: CampaignStore, args: argparse.Namespace, progress: Progress) -> None:
+def run_local(config: PlannerConfig, store: CampaignStore, args: argparse.Namespace, progress: Progress,
+              seed: int | None) -> None:
     """The same campaign through the Python API: planner and emulator in this process, same store."""
-    names, objectives = emulator_settings(config)
-    planner = Planner(config, seed=args.seed)
+    kind, names, objectives = emulator_settings(config)
+    emulator = (RedoxEmulator(noise=args.noise, seed=seed) if kind == "redox"
+                else FlowReactorEmulator(seed=seed, parameters=tuple(names)))
+    planner = Planner(config, seed=seed)
     planner.tell(store.observations())
-    emulator = FlowReactorEmulator(seed=args.seed)
     while len(planner.observations) < args.budget:
         for proposal in planner.ask():
-            result = emulator.run(*(proposal.params[n] for n in names)).as_dict()
+            result = emulator.measure(proposal.params)
             observation = planner.tell({"experiment_id": proposal.experiment_id, "params": proposal.params,
                                         "objectives": {k: result[k] for k in objectives}, "meta": result})[0]
             store.add_observation(observation)
@@ -104,19 +110,21 @@ def stop(processes: list[subprocess.Popen], env: dict[str, str]) -> None:
 
 
 def run_ros(config_path: str, config: PlannerConfig, store: CampaignStore, args: argparse.Namespace,
-            progress: Progress, out: Path) -> None:
+            progress: Progress, out: Path, seed: int | None) -> None:
     """Planner node and emulator node as separate processes over DDS on loopback; progress read from the store."""
-    names, objectives = emulator_settings(config)
+    kind, names, objectives = emulator_settings(config)
     env = ros_environment(domain_id=args.domain_id)
     env["ROS_LOG_DIR"] = str(out / "ros_logs")
-    seed = args.seed if args.seed is not None else -1
+    seed = -1 if seed is None else seed
     planner_cmd = [sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args",
                    "-p", f"config:={config_path}", "-p", f"storage:={store.path}", "-p", f"seed:={seed}",
                    "-p", f"acquisition_optimizer:={config.general.acquisition_optimizer}"]
-    emulator_cmd = [sys.executable, "-m", "gryffin_ros.nodes.flow_reactor_node", "--ros-args",
+    emulator_cmd = [sys.executable, "-m", "gryffin_ros.nodes.emulator_node", kind, "--ros-args",
                     "-p", f"seed:={seed}", "-p", f"experiment_time_s:={args.experiment_time}",
-                    "-p", f"parameters:=[{','.join(names)}]", "-p", f"objectives:=[{','.join(objectives)}]"]
-    logs = [open(out / "planner_node.log", "w"), open(out / "flow_reactor_node.log", "w")]
+                    "-p", f"objectives:=[{','.join(objectives)}]"]
+    emulator_cmd += (["-p", f"noise:={str(args.noise).lower()}"] if kind == "redox"
+                     else ["-p", f"parameters:=[{','.join(names)}]"])
+    logs = [open(out / "planner_node.log", "w"), open(out / f"{kind}_node.log", "w")]
     processes = [subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT)
                  for cmd, log in zip((planner_cmd, emulator_cmd), logs)]
     try:
@@ -166,21 +174,18 @@ def plot(store: CampaignStore, config: PlannerConfig, path: Path) -> None:
     plt.close(fig)
 
 
-def campaign(args: argparse.Namespace) -> int:
-    config_path = str(Path(args.config).resolve()) if args.config else str(share_path("examples") / "flow_reactor.yaml")
-    config = load_config(config_path)
-    out = Path(args.out) if args.out else Path.cwd() / f"campaign-{config.name}-{time.strftime('%Y%m%d-%H%M%S')}"
+def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespace, out: Path,
+                 seed: int | None) -> tuple[int, dict[str, float] | None, bool]:
+    """One campaign into `out`: store, CSV, PNG. Returns (experiments, best objectives, interrupted)."""
     out.mkdir(parents=True, exist_ok=True)
     store = CampaignStore(out / "campaign.sqlite", config.raw, config.hash)
     progress = Progress(args.budget)
-    print(f"campaign '{config.name}' ({config_path}), budget {args.budget}, "
-          f"{'Python API' if args.no_ros else 'planner node + flow-reactor emulator node over ROS 2'}; output {out}")
     interrupted = False
     try:
         if args.no_ros:
-            run_local(config, store, args, progress)
+            run_local(config, store, args, progress, seed)
         else:
-            run_ros(config_path, config, store, args, progress, out)
+            run_ros(config_path, config, store, args, progress, out, seed)
     except KeyboardInterrupt:
         interrupted = True
     finally:
@@ -188,9 +193,32 @@ def campaign(args: argparse.Namespace) -> int:
         rows = store.export_csv(out / "experiments.csv")
         if rows:
             plot(store, config, out / "best_so_far.png")
+        count, best = best_value(config, store) if rows else (0, None)
         store.close()
-    count = rows
-    print(f"{count} experiment(s): {out / 'experiments.csv'}, {out / 'best_so_far.png'}, {out / 'campaign.sqlite'}")
+    print(f"{rows} experiment(s): {out / 'experiments.csv'}, {out / 'best_so_far.png'}, {out / 'campaign.sqlite'}")
+    return count, best, interrupted
+
+
+def campaign(args: argparse.Namespace) -> int:
+    config_path = str(Path(args.config).resolve()) if args.config else str(share_path("examples") / "flow_reactor.yaml")
+    config = load_config(config_path)
+    emulator_settings(config)  # fail before starting anything when no emulator fits
+    out = Path(args.out) if args.out else Path.cwd() / f"campaign-{config.name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    transport = "Python API" if args.no_ros else "planner node + emulator node over ROS 2"
+    print(f"campaign '{config.name}' ({config_path}), budget {args.budget}, {transport}; output {out}")
+    if args.seeds is None:
+        return 130 if run_campaign(config_path, config, args, out, args.seed)[2] else 0
+    first = args.seed or 0
+    rows = ["| seed | experiments | best |", "|---|---|---|"]
+    for seed in range(first, first + args.seeds):
+        print(f"seed {seed}:")
+        count, best, interrupted = run_campaign(config_path, config, args, out / f"seed-{seed}", seed)
+        shown = "-" if best is None else ", ".join(f"{k} {v:.4g}" for k, v in best.items())
+        rows.append(f"| {seed} | {count} | {shown} |")
+        if interrupted:
+            break
+    (out / "summary.md").write_text(f"campaign '{config.name}', budget {args.budget}\n\n" + "\n".join(rows) + "\n")
+    print("\n".join(rows))
     return 130 if interrupted else 0
 
 
@@ -217,6 +245,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     run.add_argument("--experiment-time", type=float, default=0.0, help="emulated seconds per experiment")
     run.add_argument("--domain-id", type=int, default=None, help="ROS_DOMAIN_ID (default: from the environment)")
     run.add_argument("--no-ros", action="store_true", help="run planner and emulator in this process, no ROS")
+    run.add_argument("--seeds", type=int, default=None,
+                     help="run N campaigns (seeds from --seed, default 0) into <out>/seed-<k>/, with a summary")
+    run.add_argument("--noise", action="store_true", help="redox emulator: add the published noise to DFT values")
     run.set_defaults(handler=campaign)
     exp = sub.add_parser("export", help="write a campaign store's experiments as CSV and/or JSON")
     exp.add_argument("store", help="campaign SQLite file")
@@ -226,6 +257,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if getattr(args, "budget", 1) < 1:
         parser.error("--budget must be at least 1")
+    if (getattr(args, "seeds", None) or 1) < 1:
+        parser.error("--seeds must be at least 1")
     try:
         return args.handler(args)
     except GryffinRosError as exc:

@@ -7,6 +7,7 @@ forward pass (weights drawn from their mean-field Gaussians), so repeated experi
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
 
@@ -47,7 +48,10 @@ def _softplus(x: np.ndarray) -> np.ndarray:
 
 
 class FlowReactorEmulator:
-    def __init__(self, seed: int | None = None):
+    outputs = OUTPUTS
+
+    def __init__(self, seed: int | None = None, parameters: tuple[str, str, str] = ("F_C", "F_S", "T")):
+        self.parameters = tuple(parameters)
         data = resources.files("gryffin_ros.emulators").joinpath("data")
         with data.joinpath("fullerenes_weights.npz").open("rb") as handle:
             weights = dict(np.load(handle))
@@ -78,3 +82,7 @@ class FlowReactorEmulator:
         """One experiment: a single stochastic pass."""
         x = self.predict(np.array([[c60_flow, sultine_flow, temperature]]))[0, 0]
         return FlowReactorResult(*map(float, x), cost=reagent_cost(c60_flow, sultine_flow))
+
+    def measure(self, params: Mapping[str, float]) -> dict[str, float]:
+        """One experiment from a parameter dict (names in `parameters`): every output."""
+        return self.run(*(float(params[n]) for n in self.parameters)).as_dict()

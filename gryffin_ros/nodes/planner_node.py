@@ -62,7 +62,8 @@ class PlannerNode(Node):
         self.accept_unsolicited = p["accept_unsolicited"]
 
         raw = read_config(p["config"])
-        config = load_config(raw)  # validates; its hash identifies the campaign in the store
+        base_dir = Path(p["config"]).resolve().parent
+        config = load_config(raw, base_dir)  # validates; its hash identifies the campaign in the store
         storage = p["storage"] or str(Path.cwd() / f"{config.name}.sqlite")
         self.store = CampaignStore(storage, config.raw, config.hash)
         self.campaign = config.name
@@ -71,7 +72,7 @@ class PlannerNode(Node):
         # node parameters choose how to optimize, not what: they are applied after the campaign hash
         tuned = copy.deepcopy(config.raw)
         tuned.setdefault("general", {})["acquisition_optimizer"] = p["acquisition_optimizer"]
-        self.planner = self._restore(tuned, seed)
+        self.planner = self._restore(tuned, seed, base_dir)
         fraction = self.planner.feasible_fraction  # contradictory constraints fail here, before anything starts
 
         self._planner_lock = threading.Lock()
@@ -105,7 +106,7 @@ class PlannerNode(Node):
             f"campaign '{self.campaign}' in {storage}: {len(self._reported)} observation(s), {len(self._pending)} "
             f"pending; feasible fraction {fraction.value:.3g} ({fraction.method}); seed {seed}")
 
-    def _restore(self, config: dict, seed: int) -> Planner:
+    def _restore(self, config: dict, seed: int, base_dir: Path) -> Planner:
         proposals = self.store.proposals()
         observations = self.store.observations()
         reported = {o.experiment_id for o in observations}
@@ -116,7 +117,7 @@ class PlannerNode(Node):
             "ask_count": int(self.store.get_meta("ask_count") or 0),
             "proposal_count": int(self.store.get_meta("proposal_count") or 0),
         }
-        return Planner.from_state(state)
+        return Planner.from_state(state, base_dir=base_dir)
 
     # ---- outputs ---------------------------------------------------------------------------------------------
     def _publish(self, publisher, text: str) -> None:

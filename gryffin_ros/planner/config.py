@@ -69,6 +69,7 @@ class PlannerConfig:
     general: GeneralSettings
     constraint_specs: list[Any] = field(default_factory=list)
     raw: dict = field(default_factory=dict)
+    base_dir: Path | None = None  # relative file names in the config (lookup tables) are taken from here
 
     @property
     def hash(self) -> str:
@@ -161,8 +162,24 @@ def _objectives(spec: Any, parameter_names: tuple[str, ...]) -> list[Objective]:
     return out
 
 
-def load_config(source: Mapping | str | Path) -> PlannerConfig:
+def _with_base_dir(constraints: list[Any], base_dir: Path | None) -> list[Any]:
+    """Constraint specs with relative `file` options of plugins made absolute against the config's folder."""
+    out = []
+    for spec in constraints:
+        options = spec.get("options") if isinstance(spec, Mapping) else None
+        if base_dir is not None and isinstance(options, Mapping) and isinstance(options.get("file"), str) \
+                and not Path(options["file"]).is_absolute():
+            spec = {**spec, "options": {**options, "file": str(base_dir / options["file"])}}
+        out.append(spec)
+    return out
+
+
+def load_config(source: Mapping | str | Path, base_dir: str | Path | None = None) -> PlannerConfig:
+    """Validate a config; relative file names in it are resolved against `base_dir`, by default the folder of the
+    config file (or the working directory for a dict)."""
     raw = read_config(source)
+    if base_dir is None and isinstance(source, (str, Path)):
+        base_dir = Path(source).resolve().parent
     unknown = set(raw) - TOP_LEVEL_KEYS
     if unknown:
         raise ConfigError(f"unknown top-level config key(s) {sorted(unknown)}; allowed: {sorted(TOP_LEVEL_KEYS)}")
@@ -177,4 +194,5 @@ def load_config(source: Mapping | str | Path) -> PlannerConfig:
     name = raw.get("name", "campaign")
     if not isinstance(name, str) or not name:
         raise ConfigError("'name' must be a non-empty string")
-    return PlannerConfig(name, space, objectives, general, constraints, raw)
+    base = Path(base_dir) if base_dir is not None else None
+    return PlannerConfig(name, space, objectives, general, _with_base_dir(constraints, base), raw, base)

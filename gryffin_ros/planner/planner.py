@@ -157,7 +157,7 @@ class BasePlanner:
                     raise ObservationError(f"unknown key(s) {sorted(unknown)}; parameters are "
                                            f"{list(self.space.names)}, objectives {sorted(names)}")
                 params = {k: item[k] for k in self.space.names if k in item}
-                objectives = {k: item.get(k) for k in names}
+                objectives = {o.name: item.get(o.name) for o in self.objectives}
                 experiment_id, meta = item.get("experiment_id"), {}
         else:
             raise ObservationError(f"an observation must be a mapping, got {type(item).__name__}")
@@ -181,7 +181,7 @@ class BasePlanner:
         missing = known - set(objectives)
         if missing:
             raise ObservationError(f"missing objective(s) {sorted(missing)}")
-        values = {name: _objective_value(name, objectives[name]) for name in known}
+        values = {o.name: _objective_value(o.name, objectives[o.name]) for o in self.objectives}
         violated = self.constraints.violated(clean)
         if violated:
             raise ObservationError(f"parameters {clean} violate the known constraint(s) {violated}")
@@ -300,12 +300,14 @@ class BasePlanner:
         }
 
     @classmethod
-    def from_state(cls, state: Mapping[str, Any], known_constraints: ConstraintArg = None) -> BasePlanner:
+    def from_state(cls, state: Mapping[str, Any], known_constraints: ConstraintArg = None,
+                   base_dir: str | Path | None = None) -> BasePlanner:
+        """Rebuild a planner from `state()`; `base_dir` resolves relative file names in its config."""
         if not isinstance(state, Mapping) or state.get("format") != STATE_FORMAT:
             raise ConfigError(f"not a planner state of format {STATE_FORMAT}")
         if state.get("strategy") != cls.__name__:
             raise ConfigError(f"state was saved by {state.get('strategy')!r}, not {cls.__name__}")
-        planner = cls(state["config"], known_constraints, state["seed"])
+        planner = cls(load_config(state["config"], base_dir), known_constraints, state["seed"])
         planner.observations = [planner.parse_observation(o) for o in state["observations"]]
         planner.pending = {p["experiment_id"]: Proposal(p["experiment_id"], p["params"], p.get("strategy"))
                            for p in state["pending"]}

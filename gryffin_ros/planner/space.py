@@ -144,8 +144,9 @@ def parameter_from_spec(spec: Mapping[str, Any], position: int) -> Parameter:
 
     options = spec.get("options")
     details = spec.get("category_details")
-    if options is None and isinstance(details, Mapping):
-        options = list(details)
+    for table in (details, spec.get("descriptors")):
+        if options is None and isinstance(table, Mapping):
+            options = list(table)
     if isinstance(details, str):
         raise ConfigError(f"{where}: 'category_details' as a file path is not supported; give a mapping option -> list")
     if not isinstance(options, (list, tuple)) or len(options) < 2:

@@ -1,0 +1,125 @@
+"""ROS 2 emulator nodes that close the loop in simulation: `flow_reactor_emulator` (the C60 flow reactor BNN) and
+`redox_emulator` (DFT lookup of benzothiadiazole candidates). Each runs every new proposed experiment through its
+emulator and publishes one observation per experiment, optionally after a simulated experiment time and with
+injected failures (objectives null); every output goes into `meta`."""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.node import Node
+from std_msgs.msg import String
+
+from .. import messages
+from ..emulators import FlowReactorEmulator, RedoxEmulator
+from ..planner import GryffinRosError
+from .qos import LATCHED_QOS, OBSERVATIONS_QOS
+from .runner import run
+
+COMMON = {
+    "experiment_time_s": (0.0, "simulated duration of one experiment, in seconds"),
+    "failure_rate": (0.0, "probability that an experiment fails (reported with objectives null)"),
+    "seed": (-1, "random seed of the emulator; -1 = random"),
+}
+KINDS: dict[str, dict[str, Any]] = {
+    "flow_reactor_emulator": {
+        "parameters": {
+            "parameters": (["F_C", "F_S", "T"], "names of the C60 flow, sultine flow and temperature parameters"),
+            "objectives": (["X1_X2", "cost"], "outputs reported as objectives, any of X0 X1 X2 X3 X1_X2 cost"),
+        },
+        "make": lambda p, seed: FlowReactorEmulator(seed=seed, parameters=tuple(p["parameters"])),
+    },
+    "redox_emulator": {
+        "parameters": {
+            "objectives": (["abs_lam_diff", "ered", "gsol"], "outputs reported as objectives"),
+            "noise": (False, "add the published per-candidate Gaussian noise to the DFT values"),
+        },
+        "make": lambda p, seed: RedoxEmulator(noise=p["noise"], seed=seed),
+    },
+}
+
+
+class EmulatorNode(Node):
+    def __init__(self, kind: str) -> None:
+        super().__init__(kind)
+        declared = {**COMMON, **KINDS[kind]["parameters"]}
+        for name, (default, description) in declared.items():
+            self.declare_parameter(name, default, ParameterDescriptor(description=description))
+        p = {name: self.get_parameter(name).value for name in declared}
+        if not 0.0 <= p["failure_rate"] <= 1.0:
+            raise GryffinRosError(f"parameter 'failure_rate' must be in [0, 1], got {p['failure_rate']}")
+        if p["experiment_time_s"] < 0:
+            raise GryffinRosError(f"parameter 'experiment_time_s' must be >= 0, got {p['experiment_time_s']}")
+        if "parameters" in p and len(p["parameters"]) != 3:
+            raise GryffinRosError("parameter 'parameters' must name three parameters: C60 flow, sultine flow, T")
+        seed = None if p["seed"] < 0 else p["seed"]
+        self.emulator = KINDS[kind]["make"](p, seed)
+        unknown = set(p["objectives"]) - set(self.emulator.outputs)
+        if unknown or not p["objectives"]:
+            raise GryffinRosError(f"parameter 'objectives' must list outputs among {list(self.emulator.outputs)}, "
+                                  f"got {list(p['objectives'])}")
+        self.experiment_time, self.failure_rate = p["experiment_time_s"], p["failure_rate"]
+        self.objectives = list(p["objectives"])
+        self.rng = np.random.default_rng(None if seed is None else seed + 1)
+        self.queue: deque[dict] = deque()
+        self.seen: set[str] = set()
+        self.running: tuple[dict, float] | None = None
+        self.publisher = self.create_publisher(String, "/gryffin_planner/observations", OBSERVATIONS_QOS)
+        self.create_subscription(String, "/gryffin_planner/proposals", self._on_proposals, LATCHED_QOS)
+        self.create_timer(0.005, self._work)
+
+    def _on_proposals(self, msg: String) -> None:
+        try:
+            document = messages.parse("proposals", msg.data)
+        except GryffinRosError as exc:
+            self.get_logger().warning(f"ignoring proposals message: {exc}")
+            return
+        for proposal in document["proposals"]:
+            if proposal["experiment_id"] in self.seen:
+                continue
+            missing = [n for n in self.emulator.parameters if n not in proposal["params"]]
+            if missing:
+                self.get_logger().warning(f"proposal {proposal['experiment_id']} lacks {missing}; skipped")
+                continue
+            self.seen.add(proposal["experiment_id"])
+            self.queue.append(proposal)
+
+    def _work(self) -> None:
+        if self.running is None:
+            if not self.queue:
+                return
+            self.running = (self.queue.popleft(), time.monotonic())
+        proposal, started = self.running
+        if time.monotonic() - started < self.experiment_time:
+            return
+        self.running = None
+        try:
+            result = self.emulator.measure(proposal["params"])
+        except (KeyError, TypeError, ValueError) as exc:
+            self.get_logger().warning(f"cannot emulate {proposal['experiment_id']}: {exc!r}; reported as failed")
+            result = None
+        failed = result is None or self.rng.random() < self.failure_rate
+        observation = {"experiment_id": proposal["experiment_id"], "params": proposal["params"],
+                       "objectives": None if failed else {k: result[k] for k in self.objectives}}
+        if result is not None:
+            observation["meta"] = result
+        self.publisher.publish(String(data=messages.dump("observation", observation)))
+
+
+def _main(kind: str) -> Callable[[list[str] | None], int]:
+    def main(args: list[str] | None = None) -> int:
+        return run(lambda: EmulatorNode(kind), kind, args)
+    return main
+
+
+flow_reactor_main = _main("flow_reactor_emulator")
+redox_main = _main("redox_emulator")
+
+if __name__ == "__main__":
+    sys.exit({"flow_reactor": flow_reactor_main, "redox": redox_main}[sys.argv.pop(1)](None))
