@@ -11,6 +11,8 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from .emulators import FlowReactorEmulator, RedoxEmulator
 from .paths import share_path
 from .planner import GryffinRosError, Planner
@@ -150,25 +152,26 @@ def run_ros(config_path: str, config: PlannerConfig, store: CampaignStore, args:
 
 
 def plot(store: CampaignStore, config: PlannerConfig, path: Path) -> None:
-    """Best-so-far trace of each objective against the experiment number."""
+    """The objectives of the best experiment so far (by the campaign's merit, Chimera included) per experiment."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    observations = store.observations()
+    judge = Planner(config, seed=0)
+    observations, successful, trace = store.observations(), [], []
+    for o in observations:
+        if not o.failed:
+            successful.append(o)
+        best = successful[int(np.argmin(judge.merits(successful)))] if successful else None
+        trace.append([float("nan") if best is None else best.objectives[obj.name] for obj in config.objectives])
+    values = np.array(trace)
     fig, axes = plt.subplots(1, len(config.objectives), figsize=(5 * len(config.objectives), 3.6), squeeze=False)
-    for ax, objective in zip(axes[0], config.objectives):
-        best, trace = None, []
-        for o in observations:
-            value = o.objectives.get(objective.name)
-            if value is not None and (best is None or (value > best if objective.goal == "max" else value < best)):
-                best = value
-            trace.append(float("nan") if best is None else best)
-        ax.plot(range(1, len(trace) + 1), trace, drawstyle="steps-post", color="tab:blue")
+    for k, (ax, objective) in enumerate(zip(axes[0], config.objectives)):
+        ax.plot(range(1, len(values) + 1), values[:, k], drawstyle="steps-post", color="tab:blue")
         ax.set_xlabel("experiment")
-        ax.set_ylabel(f"best {objective.name} ({objective.goal})")
+        ax.set_ylabel(f"{objective.name} ({objective.goal})")
         ax.grid(alpha=0.3)
-    fig.suptitle(f"campaign '{config.name}': best so far")
+    fig.suptitle(f"campaign '{config.name}': the best experiment so far")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
