@@ -245,7 +245,7 @@ class BasePlanner:
         points, strategies = self._propose(n, rng)
         self._ask_count += 1
         proposals = []
-        for _x, strategy, params in zip(points, strategies, self.space.to_params(points)):
+        for strategy, params in zip(strategies, self.space.to_params(points)):
             proposal = Proposal(str(uuid.uuid4()), params, strategy)
             self.pending[proposal.experiment_id] = proposal
             proposals.append(proposal)
