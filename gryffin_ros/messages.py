@@ -37,15 +37,20 @@ def _reject_constant(value: str) -> None:
     raise ValueError(f"{value} is not valid JSON")
 
 
-def parse(name: str, text: str) -> Any:
+def parse(name: str, text: str, max_bytes: int = MAX_MESSAGE_BYTES) -> Any:
     """Parse and validate an incoming payload; raises MessageError with a reason a sender can act on."""
-    if len(text.encode("utf-8", errors="replace")) > MAX_MESSAGE_BYTES:
-        raise MessageError(f"message larger than {MAX_MESSAGE_BYTES} bytes")
+    if len(text) > max_bytes or len(text.encode("utf-8", errors="replace")) > max_bytes:
+        raise MessageError(f"message larger than {max_bytes} bytes")
     try:
         document = json.loads(text, parse_constant=_reject_constant)
-    except (ValueError, RecursionError) as exc:
+    except RecursionError:
+        raise MessageError("JSON nested too deeply") from None
+    except ValueError as exc:
         raise MessageError(f"malformed JSON: {exc}") from None
-    check(name, document)
+    try:
+        check(name, document)
+    except RecursionError:
+        raise MessageError("JSON nested too deeply") from None
     return document
 
 

@@ -34,6 +34,7 @@ PARAMETERS = {
     "seed": (-1, "random seed; -1 = random (kept in the store, so a restart continues with it)"),
     "auto_propose": (True, "publish the next proposals as soon as all pending experiments have reported"),
     "accept_unsolicited": (False, "accept observations whose experiment_id this planner never proposed"),
+    "max_message_bytes": (messages.MAX_MESSAGE_BYTES, "larger incoming messages are refused unparsed"),
 }
 
 
@@ -60,6 +61,9 @@ class PlannerNode(Node):
                                f"{p['acquisition_optimizer']!r}")
         self.batch_size, self.auto_propose = p["batch_size"], p["auto_propose"]
         self.accept_unsolicited = p["accept_unsolicited"]
+        if p["max_message_bytes"] < 1024:
+            raise StartupError(f"parameter 'max_message_bytes' must be at least 1024, got {p['max_message_bytes']}")
+        self.max_message_bytes = p["max_message_bytes"]
 
         raw = read_config(p["config"])
         base_dir = Path(p["config"]).resolve().parent
@@ -147,9 +151,13 @@ class PlannerNode(Node):
     # ---- inputs ----------------------------------------------------------------------------------------------
     def _on_observation(self, msg: String) -> None:
         try:
-            items = messages.observation_items(messages.parse("observation", msg.data))
+            items = messages.observation_items(messages.parse("observation", msg.data, self.max_message_bytes))
         except GryffinRosError as exc:
             self._event("observation_rejected", reason=str(exc))
+            return
+        except Exception as exc:  # whatever a sender manages to trigger, the node stays up and says so
+            self.get_logger().error(f"internal error parsing an observation message: {exc!r}")
+            self._event("observation_rejected", reason=f"internal error: {exc!r}")
             return
         for item in items:
             try:
