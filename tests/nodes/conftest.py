@@ -52,10 +52,12 @@ class Client(Node):
         super().__init__("test_lab_client")
         self.events: list[dict] = []
         self.proposals: list[dict] = []
+        self.statuses: list[dict] = []
         self.lock = threading.Lock()
         self.publisher = self.create_publisher(String, "/gryffin_planner/observations", OBSERVATIONS_QOS)
         self.create_subscription(String, "/gryffin_planner/events", self._record(self.events), EVENTS_QOS)
         self.create_subscription(String, "/gryffin_planner/proposals", self._record(self.proposals), LATCHED_QOS)
+        self.create_subscription(String, "/gryffin_planner/status", self._record(self.statuses), LATCHED_QOS)
         self.recommend_client = self.create_client(Trigger, "/gryffin_planner/recommend")
         self.status_client = self.create_client(Trigger, "/gryffin_planner/get_status")
 
@@ -115,6 +117,7 @@ def client(lab_session):
     with lab_session.lock:
         lab_session.events.clear()
         lab_session.proposals.clear()
+        lab_session.statuses.clear()
     return lab_session
 
 
@@ -170,12 +173,24 @@ class PlannerProcess:
 
 
 @pytest.fixture
-def start_planner(tmp_path):
+def start_planner(tmp_path, lab_session):
+    """Start a planner node; unless told otherwise wait until it runs and its latched status reached the lab client
+    (a node of an earlier test may still be known to DDS for a moment, so its service is no sign of the new one)."""
     started: list[PlannerProcess] = []
 
-    def start(config: dict = FLOW_CONFIG, **params) -> PlannerProcess:
+    def start(config: dict = FLOW_CONFIG, wait: bool = True, **params) -> PlannerProcess:
+        with lab_session.lock:
+            seen = len(lab_session.statuses)
         process = PlannerProcess(tmp_path, config, **params)
         started.append(process)
+        deadline = time.monotonic() + 60
+        while wait:
+            with lab_session.lock:
+                if len(lab_session.statuses) > seen and "campaign '" in process.output():
+                    break
+            assert process.process.poll() is None, f"planner node exited: {process.output()}"
+            assert time.monotonic() < deadline, "planner node did not come up"
+            time.sleep(0.05)
         return process
     yield start
     for process in started:

@@ -94,7 +94,7 @@ def test_restart_on_the_same_store_resumes_and_refuses_another_config(client, st
     client.wait_events(start + 4)
     assert client.status()["best"]["objectives"] == {"X1_X2": 0.8}
     other = {**FLOW_CONFIG, "constraints": ["F_C + F_S <= 100"]}
-    refused = start_planner(other, auto_propose=False)
+    refused = start_planner(other, wait=False, auto_propose=False)
     assert refused.process.wait(timeout=60) == 2
     assert "different config" in refused.output()
 
@@ -120,7 +120,7 @@ def test_third_party_plugin_loads_and_a_raising_plugin_is_reported(client, start
         (proposal,) = json.loads(client.recommend().message)["proposals"]
         assert proposal["params"]["F_C"] + proposal["params"]["F_S"] <= 60
     planner = start_planner({**FLOW_CONFIG, "name": "exploding", "constraints": [{"plugin": "test_exploding"}]},
-                            auto_propose=False, storage="\":memory:\"")
+                            wait=False, auto_propose=False, storage="\":memory:\"")
     assert planner.process.wait(timeout=60) == 2  # V_C is estimated at start-up: the broken plugin stops it there
     assert "'test_exploding' raised RuntimeError: interlock controller unreachable" in planner.output()
 
