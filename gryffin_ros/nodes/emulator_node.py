@@ -69,6 +69,7 @@ class EmulatorNode(Node):
         self.rng = np.random.default_rng(None if seed is None else seed + 1)
         self.queue: deque[dict] = deque()
         self.seen: set[str] = set()
+        self.reported: dict[str, str] = {}  # experiment_id -> the observation message sent
         self.running: tuple[dict, float] | None = None
         self.publisher = self.create_publisher(String, "/gryffin_planner/observations", OBSERVATIONS_QOS)
         self.create_subscription(String, "/gryffin_planner/proposals", self._on_proposals, LATCHED_QOS)
@@ -81,6 +82,11 @@ class EmulatorNode(Node):
             self.get_logger().warning(f"ignoring proposals message: {exc}")
             return
         for proposal in document["proposals"]:
+            if proposal["experiment_id"] in self.reported:
+                # announced again (the planner restarted): the report may have been lost, so send it again; a
+                # planner that has it already rejects the copy as a duplicate
+                self.publisher.publish(String(data=self.reported[proposal["experiment_id"]]))
+                continue
             if proposal["experiment_id"] in self.seen:
                 continue
             missing = [n for n in self.emulator.parameters if n not in proposal["params"]]
@@ -109,7 +115,9 @@ class EmulatorNode(Node):
                        "objectives": None if failed else {k: result[k] for k in self.objectives}}
         if result is not None:
             observation["meta"] = result
-        self.publisher.publish(String(data=messages.dump("observation", observation)))
+        text = messages.dump("observation", observation)
+        self.reported[proposal["experiment_id"]] = text
+        self.publisher.publish(String(data=text))
 
 
 def _main(kind: str) -> Callable[[list[str] | None], int]:

@@ -10,6 +10,7 @@ import json
 import secrets
 import sys
 import threading
+import time
 from pathlib import Path
 
 from rcl_interfaces.msg import ParameterDescriptor
@@ -36,6 +37,9 @@ PARAMETERS = {
     "accept_unsolicited": (False, "accept observations whose experiment_id this planner never proposed"),
     "max_message_bytes": (messages.MAX_MESSAGE_BYTES, "larger incoming messages are refused unparsed"),
 }
+
+
+REMIND_AFTER_S = 5.0
 
 
 class StartupError(GryffinRosError):
@@ -82,7 +86,7 @@ class PlannerNode(Node):
         self._planner_lock = threading.Lock()
         self._state_lock = threading.Lock()
         self._inbox: list[Observation] = []
-        self._pending = set(self.planner.pending)
+        self._pending = dict(self.planner.pending)  # experiment_id -> Proposal still owed
         self._reported = {o.experiment_id for o in self.planner.observations}
         self._n_failed = sum(o.failed for o in self.planner.observations)
         self._best = self.planner.best()
@@ -101,6 +105,9 @@ class PlannerNode(Node):
         self.create_service(Trigger, "~/recommend", self._on_recommend, callback_group=optimizer_group)
         # auto-propose runs when woken (start-up, an accepted observation) instead of polling with a timer
         self._wake = self.create_guard_condition(self._auto_propose, callback_group=optimizer_group)
+        # experiments still owed after a quiet spell are announced again (a report may have been lost in a restart)
+        self._last_input = time.monotonic()
+        self.create_timer(REMIND_AFTER_S / 2, self._remind, callback_group=status_group)
         if self._pending:  # after a restart, the experiments still owed are announced again
             self._publish(self.proposals_pub, messages.proposals_message(
                 self.campaign, list(self.planner.pending.values()), len(self.planner.observations)))
@@ -188,8 +195,9 @@ class PlannerNode(Node):
             self._event("observation_rejected", experiment_id, str(exc))
             return
         with self._state_lock:
+            self._last_input = time.monotonic()
             self._inbox.append(observation)
-            self._pending.discard(experiment_id)
+            self._pending.pop(experiment_id, None)
             self._n_failed += observation.failed
             self._ask_blocked = False
         self._event("observation_accepted", experiment_id)
@@ -210,6 +218,15 @@ class PlannerNode(Node):
             best = self.planner.best()
             with self._state_lock:
                 self._best = best
+
+    def _remind(self) -> None:
+        with self._state_lock:
+            owed = list(self._pending.values())
+            quiet = time.monotonic() - self._last_input > REMIND_AFTER_S
+            if quiet:
+                self._last_input = time.monotonic()
+        if owed and quiet and self.auto_propose:
+            self._publish(self.proposals_pub, messages.proposals_message(self.campaign, owed, len(self._reported)))
 
     def _on_get_status(self, request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
         response.success, response.message = True, messages.dump("status", self.status())
@@ -237,7 +254,7 @@ class PlannerNode(Node):
                 self._publish_status()
                 raise exc
             with self._state_lock:
-                self._pending.update(p.experiment_id for p in proposals)
+                self._pending.update((p.experiment_id, p) for p in proposals)
                 self._state = "idle"
             self._absorb()  # what arrived while optimizing
         self._event("proposals_ready", reason=f"{len(proposals)} proposal(s) after "
