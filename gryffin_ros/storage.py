@@ -103,12 +103,15 @@ class CampaignStore:
             self._db.close()
 
     # ---- campaign data ---------------------------------------------------------------------------------------
-    def add_proposals(self, proposals: Iterable[Proposal]) -> None:
+    def add_proposals(self, proposals: Iterable[Proposal], meta: dict[str, str] | None = None) -> None:
+        """Store proposals, and meta values that go with them, in one transaction."""
         now = time.time()
         with self._transaction():
             self._db.executemany(
                 "INSERT INTO proposals (experiment_id, params, strategy, created) VALUES (?, ?, ?, ?)",
                 [(p.experiment_id, json.dumps(p.params), p.strategy, now) for p in proposals])
+            for key, value in (meta or {}).items():
+                self._set_meta(key, value)
 
     def add_observation(self, observation: Observation, raw: str | None = None) -> None:
         """Commit one observation; a second one with the same experiment_id raises StoreError."""

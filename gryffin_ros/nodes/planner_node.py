@@ -241,9 +241,8 @@ class PlannerNode(Node):
             try:
                 self._absorb()
                 proposals = self.planner.ask(self.batch_size)
-                self.store.add_proposals(proposals)
-                self.store.set_meta("ask_count", str(self.planner.state()["ask_count"]))
-                self.store.set_meta("proposal_count", str(self.planner.state()["proposal_count"]))
+                self.store.add_proposals(proposals, {"ask_count": str(self.planner.ask_count),
+                                                     "proposal_count": str(self.planner.proposal_count)})
             except Exception as exc:
                 with self._state_lock:
                     self._state, self._ask_blocked = "error", True

@@ -106,6 +106,16 @@ class BasePlanner:
         self._feasible_fraction: FeasibleFraction | None = None
         self._feasible_set: np.ndarray | None = None
 
+    @property
+    def ask_count(self) -> int:
+        """How many times ask() has run (part of what makes proposals reproducible)."""
+        return self._ask_count
+
+    @property
+    def proposal_count(self) -> int:
+        """How many proposals have been made (the sampling strategies cycle with it)."""
+        return self._proposal_count
+
     # ---- randomness ------------------------------------------------------------------------------------------
     def _rng(self) -> np.random.Generator:
         """Same seed, same observations, same number of asks -> same draws."""
