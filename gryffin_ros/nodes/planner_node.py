@@ -24,7 +24,7 @@ from .. import messages
 from ..planner import GryffinRosError, Observation, Planner, Proposal
 from ..planner.config import load_config, read_config
 from ..storage import CampaignStore, StoreError
-from .qos import EVENTS_QOS, LATCHED_QOS, OBSERVATIONS_QOS
+from .qos import EVENTS_QOS, LATCHED_QOS, OBSERVATIONS_SUBSCRIPTION_QOS, SERVICES_QOS
 from .runner import run
 
 PARAMETERS = {
@@ -99,10 +99,12 @@ class PlannerNode(Node):
         self.proposals_pub = self.create_publisher(String, "~/proposals", LATCHED_QOS)
         self.events_pub = self.create_publisher(String, "~/events", EVENTS_QOS)
         self.status_pub = self.create_publisher(String, "~/status", LATCHED_QOS)
-        self.create_subscription(String, "~/observations", self._on_observation, OBSERVATIONS_QOS,
+        self.create_subscription(String, "~/observations", self._on_observation, OBSERVATIONS_SUBSCRIPTION_QOS,
                                  callback_group=observations_group)
-        self.create_service(Trigger, "~/get_status", self._on_get_status, callback_group=status_group)
-        self.create_service(Trigger, "~/recommend", self._on_recommend, callback_group=optimizer_group)
+        self.create_service(Trigger, "~/get_status", self._on_get_status, qos_profile=SERVICES_QOS,
+                            callback_group=status_group)
+        self.create_service(Trigger, "~/recommend", self._on_recommend, qos_profile=SERVICES_QOS,
+                            callback_group=optimizer_group)
         # auto-propose runs when woken (start-up, an accepted observation) instead of polling with a timer
         self._wake = self.create_guard_condition(self._auto_propose, callback_group=optimizer_group)
         # experiments still owed after a quiet spell are announced again (a report may have been lost in a restart)
