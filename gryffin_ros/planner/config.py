@@ -192,7 +192,7 @@ def load_config(source: Mapping | str | Path, base_dir: str | Path | None = None
     if not isinstance(constraints, list):
         raise ConfigError("'constraints' must be a list")
     name = raw.get("name", "campaign")
-    if not isinstance(name, str) or not name:
-        raise ConfigError("'name' must be a non-empty string")
+    if not isinstance(name, str) or not name.strip() or "/" in name or "\\" in name:
+        raise ConfigError(f"'name' must be a non-empty string without path separators, got {name!r}")
     base = Path(base_dir) if base_dir is not None else None
     return PlannerConfig(name, space, objectives, general, _with_base_dir(constraints, base), raw, base)
