@@ -5,7 +5,6 @@ conversions between JSON payloads and domain objects. No ROS here, so the CLI an
 from __future__ import annotations
 
 import json
-import math
 import time
 from functools import cache
 from typing import Any
@@ -14,7 +13,7 @@ import jsonschema
 
 from .paths import share_path
 from .planner.errors import GryffinRosError
-from .planner.planner import Observation, Proposal
+from .planner.planner import Proposal
 
 SCHEMAS = ("observation", "proposals", "event", "status", "error")
 # Larger messages are refused before they are parsed.
@@ -67,10 +66,6 @@ def dump(name: str, document: Any) -> str:
     return json.dumps(document, allow_nan=False)
 
 
-def finite_or_none(value: Any) -> Any:
-    return None if isinstance(value, float) and not math.isfinite(value) else value
-
-
 def proposals_message(campaign: str, proposals: list[Proposal], n_observations: int) -> str:
     return dump("proposals", {"campaign": campaign, "proposals": [p.to_dict() for p in proposals],
                               "n_observations": n_observations, "created": time.time()})
@@ -79,11 +74,3 @@ def proposals_message(campaign: str, proposals: list[Proposal], n_observations: 
 def observation_items(document: Any) -> list[dict]:
     """An observation payload is one observation or a list of them."""
     return document if isinstance(document, list) else [document]
-
-
-def observation_message(observation: Observation) -> dict:
-    out = {"experiment_id": observation.experiment_id, "params": observation.params,
-           "objectives": {k: finite_or_none(v) for k, v in observation.objectives.items()}}
-    if observation.meta:
-        out["meta"] = observation.meta
-    return out
