@@ -237,6 +237,48 @@ def export(args: argparse.Namespace) -> int:
     return 0
 
 
+def bench(args: argparse.Namespace) -> int:
+    """Run (or resume) the paper's benchmarks and print one summary line per surface and strategy."""
+    import json
+
+    from .benchmarks.runner import STRATEGIES, Job, format_summary, run_jobs, summarize
+    from .benchmarks.surfaces import SURFACES
+    surfaces = [s.strip() for s in args.surface.split(",") if s.strip()]
+    strategies = [s.strip() for s in args.strategy.split(",") if s.strip()]
+    unknown = [s for s in surfaces if s not in SURFACES] + [s for s in strategies if s not in STRATEGIES]
+    if unknown or not surfaces or not strategies:
+        print(f"error: unknown surface/strategy {unknown}; surfaces: {', '.join(SURFACES)}; "
+              f"strategies: {', '.join(STRATEGIES)}", file=sys.stderr)
+        return 2
+    groups: dict[tuple[str, str], list[Job]] = {}
+    for name in surfaces:
+        surface = SURFACES[name]
+        budget = args.budget or (100 if surface.kind == "continuous" else 441)
+        variant = args.variant if surface.kind == "discrete" else None
+        for strategy in strategies:
+            jobs = [Job(name, strategy, seed, budget, variant) for seed in range(args.first_seed,
+                                                                                 args.first_seed + args.seeds)]
+            groups[(name, jobs[0].label)] = jobs
+    all_jobs = [job for jobs in groups.values() for job in jobs]
+
+    def progress(job: Job, record: dict) -> None:
+        result = (f"optimum at {record['evaluations_to_optimum']}" if record["evaluations_to_optimum"]
+                  else f"best {min(record['values'], default=float('nan')):.4g}")
+        flag = f"  VIOLATIONS {record['violations']}" if record["violations"] else ""
+        flag += f"  ERROR {record['error']}" if record.get("error") else ""
+        print(f"{job.surface} {job.label} seed {job.seed}: {result} ({record['seconds']:.1f} s){flag}", flush=True)
+
+    run_jobs(all_jobs, Path(args.out), args.processes, progress)
+    summaries = {}
+    for (name, label), jobs in groups.items():
+        summary = summarize(json.loads(job.path(Path(args.out)).read_text()) for job in jobs)
+        summaries[f"{name}/{label}"] = summary
+        print(format_summary(name, label, summary))
+    if args.json:
+        Path(args.json).write_text(json.dumps(summaries, indent=1))
+    return 1 if any(s["violations"] for s in summaries.values()) else 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="gryffin-ros", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -257,8 +299,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     exp.add_argument("--csv", help="CSV file to write")
     exp.add_argument("--json", help="JSON file to write")
     exp.set_defaults(handler=export)
+    ben = sub.add_parser("bench", help="run the paper's benchmark surfaces (parallel over seeds, resumable)")
+    ben.add_argument("--surface", required=True, help="surface name(s), comma separated (e.g. branin,slope)")
+    ben.add_argument("--strategy", default="adam", help="adam, genetic, random, deap (comma separated)")
+    ben.add_argument("--seeds", type=int, default=10, help="number of runs (seeds from --first-seed)")
+    ben.add_argument("--first-seed", type=int, default=0)
+    ben.add_argument("--budget", type=int, default=None,
+                     help="evaluations per run (default 100; discrete: 441, stopping at the optimum)")
+    ben.add_argument("--variant", choices=("ordinal", "categorical"), default="ordinal",
+                     help="discrete surfaces: ordered options (1-d descriptor) or plain categorical options")
+    ben.add_argument("--processes", type=int, default=None, help="parallel runs (default: all cores)")
+    ben.add_argument("--out", default="bench-results", help="folder of per-run results (default bench-results)")
+    ben.add_argument("--json", help="also write the summaries to this JSON file")
+    ben.set_defaults(handler=bench)
     args = parser.parse_args(argv)
-    if getattr(args, "budget", 1) < 1:
+    if (getattr(args, "budget", 1) or 1) < 1:
         parser.error("--budget must be at least 1")
     if (getattr(args, "seeds", None) or 1) < 1:
         parser.error("--seeds must be at least 1")

@@ -4,7 +4,7 @@ constrained acquisition optimizers and the ask/tell Planner (plus Random and Gen
 
 from .baselines import Genetic, Random
 from .config import PlannerConfig, load_config
-from .constraints import FeasibleFraction, KnownConstraints
+from .constraints import FeasibleFraction, KnownConstraints, vectorized
 from .errors import (
                      ConfigError,
                      ConstraintError,
@@ -20,5 +20,5 @@ from .space import SearchSpace
 __all__ = [
     "BasePlanner", "ConfigError", "ConstraintError", "ExhaustedSpaceError", "Expression", "FeasibleFraction",
     "Genetic", "GryffinRosError", "KnownConstraints", "NoFeasiblePointError", "Observation", "ObservationError",
-    "Planner", "PlannerConfig", "Proposal", "Random", "SearchSpace", "load_config",
+    "Planner", "PlannerConfig", "Proposal", "Random", "SearchSpace", "load_config", "vectorized",
 ]

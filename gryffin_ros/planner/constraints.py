@@ -156,6 +156,25 @@ def constraint_from_spec(spec: Any, position: int, names: Sequence[str]) -> Name
     raise ConfigError(f"constraints[{position}] must be an expression string or a mapping, got {type(spec).__name__}")
 
 
+def vectorized(fn: Callable[[Mapping[str, np.ndarray]], Any]) -> Callable:
+    """Mark a known constraint as vectorized: it takes a dict of equal-length column arrays (users' units, categorical
+    options as strings) and returns one bool per row, so batches of candidates cost one call instead of one each."""
+    fn.vectorized = True
+    return fn
+
+
+def _callable_constraint(fn: Callable, position: int) -> NamedConstraint:
+    name = _callable_name(fn, position)
+    if not getattr(fn, "vectorized", False):
+        return NamedConstraint(name, fn)
+
+    def one(params: Mapping[str, Any]) -> bool:
+        result = np.asarray(fn({k: np.asarray([v]) for k, v in params.items()}))
+        return bool(result.reshape(-1)[0]) if result.dtype == bool and result.size == 1 else result
+
+    return NamedConstraint(name, one, fn)
+
+
 def _callable_name(fn: Callable, position: int) -> str:
     name = getattr(fn, "__name__", None) or type(fn).__name__
     return name if name != "<lambda>" else f"known_constraints[{position}]"
@@ -177,7 +196,7 @@ class KnownConstraints:
             for i, fn in enumerate(fns):
                 if not callable(fn):
                     raise ConfigError(f"known_constraints[{i}] is {type(fn).__name__}, not a callable")
-                constraints.append(NamedConstraint(_callable_name(fn, i), fn))
+                constraints.append(_callable_constraint(fn, i))
         return cls(space, constraints)
 
     def __bool__(self) -> bool:
