@@ -11,6 +11,10 @@ from .acquisition import Acquisition
 from .constraints import KnownConstraints
 
 BETA1, BETA2, EPSILON = 0.9, 0.999, 1e-8
+# Only the best REFINE_FRACTION of the start points (by their acquisition value, at least REFINE_MIN) are refined; the
+# others stay candidates at their start values. With wide kernels every start point has a gradient, and refining
+# points that start far behind the best rarely changes the proposal.
+REFINE_FRACTION, REFINE_MIN = 0.1, 64
 
 
 class AdamHillOptimizer:
@@ -29,6 +33,18 @@ class AdamHillOptimizer:
         Adam runs per point (its own moments, the usual bias correction). A point whose gradient and momentum are
         exactly zero cannot move, so it is not evaluated again until a Hill move changes it.
         """
+        keep = len(start) if len(start) <= REFINE_MIN else max(REFINE_MIN, int(REFINE_FRACTION * len(start)))
+        if keep < len(start):
+            screened = acquisition.evaluate(start)
+            best = np.argsort(screened, kind="stable")[:keep]
+            X_best, alpha_best = self._refine(acquisition, start[best], rng)
+            X, alpha = start.copy(), screened
+            X[best], alpha[best] = X_best, alpha_best
+            return X, alpha
+        return self._refine(acquisition, start, rng)
+
+    def _refine(self, acquisition: Acquisition, start: np.ndarray, rng: np.random.Generator
+                ) -> tuple[np.ndarray, np.ndarray]:
         space = self.space
         X = start.copy()
         c, f = space.cont_idx, space.finite_idx

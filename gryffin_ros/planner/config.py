@@ -49,6 +49,7 @@ class GeneralSettings:
     feas_approach: str = "fwa"
     feas_param: float = 1.0
     auto_desc_gen: bool = False
+    kernel_width: str = "auto"
 
 
 _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
@@ -56,9 +57,10 @@ _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
     "acquisition_optimizer": (str,), "obj_transform": (str,), "feasible_fraction": (int, float),
     "random_seed": (int,), "max_rejection_draws": (int,), "softness": (int, float),
     "feas_approach": (str,), "feas_param": (int, float), "auto_desc_gen": (bool,),
+    "kernel_width": (str,),
 }
 _GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"}, "obj_transform": {"sqrt", "identity"},
-                    "feas_approach": {"fwa", "fia", "fca"}}
+                    "feas_approach": {"fwa", "fia", "fca"}, "kernel_width": {"auto", "spacing", "gryffin"}}
 
 
 @dataclass

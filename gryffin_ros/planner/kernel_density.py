@@ -4,7 +4,9 @@ Every observation k (plus its mirrored copies near continuous bounds) contribute
 Continuous dims: a Gaussian with precision tau ~ Gamma(a = 12 rho^2, 1) (rho = n / V_C). Averaged over that prior
 the Gaussian becomes a Student-t with 2a >= 24 degrees of freedom and scale 1/sqrt(a); we use its Gaussian limit
 (precision a), which differs only in far tails where the uniform term of the acquisition dominates, and which lets
-all squared distances come from one matrix product instead of an (M, N, D) tensor. Finite dims: concrete
+all squared distances come from one matrix product instead of an (M, N, D) tensor. Those kernels are so narrow that
+between observations only the uniform term is left, so the planner's default (general.kernel_width = spacing) uses
+precision 16 rho^(2/C) instead: kernels a quarter of the typical data spacing wide. Finite dims: concrete
 (Gumbel-softmax) draws with temperature 0.5 + 10/rho, reshaped by descriptor distance, averaged over draws into one
 probability table per dim.
 """
@@ -78,10 +80,11 @@ class KernelDensity:
     """
 
     def __init__(self, space: SearchSpace, X: np.ndarray, merits: np.ndarray, feasible_fraction: float,
-                 generator: torch.Generator, spacing_scaled: bool = False,
+                 generator: torch.Generator, spacing_scaled: bool = False, spacing_factor: float = 1.0,
                  descriptors: Mapping[int, np.ndarray] | None = None):
-        """spacing_scaled: continuous precision rho^(2/C) (C continuous dims), i.e. kernel width = the typical spacing
-        of rho points in C dims, instead of Gryffin's 12 rho^2 (for the classifier of failed experiments).
+        """spacing_scaled: continuous precision spacing_factor * rho^(2/C) (C continuous dims), i.e. kernel width =
+        the typical spacing of rho points in C dims over sqrt(spacing_factor), instead of Gryffin's 12 rho^2 (the
+        planner's default, general.kernel_width = spacing, uses factor 16; the classifier of failed experiments 1).
         descriptors: learned descriptor tables replacing the space's for some finite dims (dynamic descriptors)."""
         self.space = space
         locations, values = mirror(space, X, merits)
@@ -94,7 +97,8 @@ class KernelDensity:
         self.loc_periodic = torch.as_tensor(locations[:, c][:, periodic], dtype=DTYPE)  # (N, P)
         self._ordinary = torch.as_tensor(np.flatnonzero(~periodic))
         self._periodic = torch.as_tensor(np.flatnonzero(periodic))
-        self.precision = self.rho ** (2.0 / max(len(c), 1)) if spacing_scaled else 12.0 * self.rho ** 2
+        self.precision = (spacing_factor * self.rho ** (2.0 / max(len(c), 1)) if spacing_scaled
+                          else 12.0 * self.rho ** 2)
         self._log_norm = 0.5 * len(c) * math.log(self.precision / (2 * math.pi))
         self._loc_sq = (self.loc ** 2).sum(1)  # (N,)
         temperature = 0.5 + 10.0 / self.rho
