@@ -88,3 +88,37 @@ def test_acquisition_limits_far_from_and_at_the_data():
     assert exploit[2] == pytest.approx(1.0, abs=1e-6)  # nothing known there: alpha = s
     assert explore[2] == pytest.approx(-1.0, abs=1e-6)
     assert explore[0] > explore[2] and exploit[0] < exploit[2]
+
+
+def test_spacing_scaled_kernels_fill_the_gaps_between_observations():
+    """Gryffin's 12 rho^2 kernels leave alpha = s (flat) between observations; the spacing-scaled kernels that
+    general.kernel_width = auto/spacing uses interpolate there, so the acquisition ranks the gaps."""
+    space = SearchSpace.from_config([{"name": "x", "type": "continuous", "low": 0, "high": 1},
+                                     {"name": "y", "type": "continuous", "low": 0, "high": 1}])
+    grid = np.linspace(0.1, 0.9, 5)
+    X = np.array([[a, b] for a in grid for b in grid])
+    merits = X.sum(axis=1) / 2  # better towards (0, 0)
+    gaps = np.array([[0.2, 0.2], [0.8, 0.8], [0.4, 0.6]])
+    narrow = Acquisition(density_for(space, X, merits), 1.0).evaluate(gaps)
+    wide_density = KernelDensity(space, X, merits, 1.0, torch.Generator().manual_seed(0), spacing_scaled=True,
+                                 spacing_factor=16.0)
+    wide = Acquisition(wide_density, 1.0).evaluate(gaps)
+    assert np.allclose(narrow, 1.0, atol=1e-6)
+    assert wide[0] < wide[2] < wide[1] < 1.0
+    assert wide_density.precision == pytest.approx(16.0 * len(mirror(space, X, merits)[0]))
+
+
+@pytest.mark.parametrize("width, dims, spacing", [("auto", 2, True), ("auto", 6, False), ("spacing", 6, True),
+                                                  ("gryffin", 2, False)])
+def test_kernel_width_setting(width, dims, spacing):
+    config = {"parameters": [{"name": f"x{i}", "type": "continuous", "low": 0, "high": 1} for i in range(dims)],
+              "objectives": [{"name": "y", "goal": "min"}], "general": {"kernel_width": width}}
+    assert Planner(config, seed=0).spacing_kernels is spacing
+
+
+def test_kernel_width_rejects_unknown_values():
+    from gryffin_ros.planner import ConfigError
+    config = {"parameters": [{"name": "x", "type": "continuous", "low": 0, "high": 1}],
+              "objectives": [{"name": "y", "goal": "min"}], "general": {"kernel_width": "wide"}}
+    with pytest.raises(ConfigError, match="kernel_width"):
+        Planner(config)

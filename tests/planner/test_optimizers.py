@@ -86,3 +86,16 @@ def test_genetic_population_stays_feasible_and_improves():
     assert len(final) == len(start)
     assert alpha.min() <= acquisition.evaluate(start).min()
     assert np.allclose(alpha, acquisition.evaluate(final))
+
+
+def test_adam_refines_only_the_most_promising_start_points():
+    constraints = KnownConstraints.build(SQUARE, ["x0 + x1 < 1.5"])
+    acquisition = acquisition_pulling_to(SQUARE, [0.5, 0.5])
+    start = np.random.default_rng(4).random((1000, 2)) * 0.7
+    before = acquisition.evaluate(start)
+    refined, alpha = AdamHillOptimizer(constraints).optimize(acquisition, start, np.random.default_rng(0))
+    moved = (refined != start).any(axis=1)
+    assert 0 < moved.sum() <= 100  # the best 10 % at most
+    assert before[moved].max() <= np.sort(before)[99]  # and only from among the best 10 % by their start value
+    assert np.allclose(alpha, acquisition.evaluate(refined)) and constraints.feasible(refined).all()
+    assert alpha.min() < before.min()
