@@ -183,14 +183,23 @@ def _callable_name(fn: Callable, position: int) -> str:
 class KnownConstraints:
     """The AND of all known constraints of a campaign, evaluated on internal points or parameter dicts."""
 
-    def __init__(self, space: SearchSpace, constraints: Sequence[NamedConstraint] = ()):
+    def __init__(self, space: SearchSpace, constraints: Sequence[NamedConstraint] = (),
+                 complete_columns: Callable[[Mapping[str, np.ndarray]], Mapping[str, np.ndarray]] | None = None,
+                 complete_row: Callable[[Mapping[str, Any]], dict] | None = None):
+        """complete_columns / complete_row add parameters that are not dims of `space` (those solved from equality
+        constraints) before any constraint sees a point."""
         self.space = space
         self.constraints = list(constraints)
+        self.complete_columns = complete_columns
+        self.complete_row = complete_row
 
     @classmethod
     def build(cls, space: SearchSpace, specs: Sequence[Any] = (),
-              callables: Callable | Sequence[Callable] | None = None) -> KnownConstraints:
-        constraints = [constraint_from_spec(s, i, space.names) for i, s in enumerate(specs)]
+              callables: Callable | Sequence[Callable] | None = None,
+              names: Sequence[str] | None = None) -> KnownConstraints:
+        """`names`: every parameter name a constraint may use (default: the space's)."""
+        names = space.names if names is None else names
+        constraints = [constraint_from_spec(s, i, names) for i, s in enumerate(specs)]
         if callables is not None:
             fns = [callables] if callable(callables) else list(callables)
             for i, fn in enumerate(fns):
@@ -208,6 +217,8 @@ class KnownConstraints:
         if not self.constraints or not len(X):
             return ok
         columns = self.space.columns(X)
+        if self.complete_columns is not None:
+            columns = self.complete_columns(columns)
         rows = None
         for c in self.constraints:
             idx = np.flatnonzero(ok)
@@ -224,6 +235,8 @@ class KnownConstraints:
                 continue
             if rows is None:
                 rows = self.space.to_params(X)
+                if self.complete_row is not None:
+                    rows = [self.complete_row(r) for r in rows]
             for i in idx:
                 ok[i] = self._call(c, rows[i])
         return ok
@@ -234,7 +247,8 @@ class KnownConstraints:
     def violated(self, params: Mapping[str, Any]) -> list[str]:
         """Names of the constraints a (valid) parameter dict violates."""
         X = self.space.to_internal([params])
-        return [c.name for c in self.constraints if not KnownConstraints(self.space, [c]).feasible(X)[0]]
+        return [c.name for c in self.constraints
+                if not KnownConstraints(self.space, [c], self.complete_columns, self.complete_row).feasible(X)[0]]
 
     @staticmethod
     def _call(c: NamedConstraint, params: dict) -> bool:

@@ -24,6 +24,7 @@ from .chimera import Chimera
 from .config import PlannerConfig, load_config
 from .constraints import FeasibleFraction, KnownConstraints, estimate_feasible_fraction
 from .descriptors import LearnedDescriptors, learn_descriptors
+from .equalities import LinearEqualities
 from .errors import ConfigError, ExhaustedSpaceError, NoFeasiblePointError, ObservationError
 from .feasibility import FeasibilityModel, combine
 from .genetic import GeneticOptimizer
@@ -95,9 +96,17 @@ class BasePlanner:
     def __init__(self, config: Mapping | str | Path | PlannerConfig, known_constraints: ConstraintArg = None,
                  seed: int | None = None):
         self.config = config if isinstance(config, PlannerConfig) else load_config(config)
-        self.space = self.config.space
+        full = self.config.space
+        # every parameter the user sees; `space` holds the ones the planner models (equality-solved ones excluded)
+        self.parameter_names: tuple[str, ...] = full.names
+        self.equalities, specs = LinearEqualities.split(self.config.constraint_specs, full)
+        self.space = self.equalities.reduced_space(full) if self.equalities else full
         self.objectives = self.config.objectives
-        self.constraints = KnownConstraints.build(self.space, self.config.constraint_specs, known_constraints)
+        self.constraints = KnownConstraints.build(self.space, specs, known_constraints, names=full.names)
+        if self.equalities:
+            self.constraints.constraints[:0] = self.equalities.bound_constraints(full)
+            self.constraints.complete_columns = self.equalities.complete_columns
+            self.constraints.complete_row = self._complete
         self._known_constraints = known_constraints
         if seed is None:
             seed = self.config.general.random_seed
@@ -112,6 +121,10 @@ class BasePlanner:
         self._proposal_count = 0
         self._feasible_fraction: FeasibleFraction | None = None
         self._feasible_set: np.ndarray | None = None
+
+    def _complete(self, params: Mapping[str, Any]) -> dict[str, Any]:
+        """The modelled parameters of a point -> all parameters (equality-solved ones computed), in config order."""
+        return self.equalities.complete(params, self.parameter_names) if self.equalities else dict(params)
 
     @property
     def ask_count(self) -> int:
@@ -159,7 +172,7 @@ class BasePlanner:
         if isinstance(item, Observation):
             params, objectives, experiment_id, meta = item.params, item.objectives, item.experiment_id, item.meta
         elif isinstance(item, Mapping):
-            if "params" in item and "params" not in self.space.names:
+            if "params" in item and "params" not in self.parameter_names:
                 unknown = set(item) - {"experiment_id", "params", "objectives", "meta"}
                 if unknown:
                     raise ObservationError(f"unknown observation field(s) {sorted(unknown)}")
@@ -169,11 +182,11 @@ class BasePlanner:
                     objectives = {o.name: None for o in self.objectives}
             else:
                 names = {o.name for o in self.objectives}
-                unknown = set(item) - set(self.space.names) - names - {"experiment_id"}
+                unknown = set(item) - set(self.parameter_names) - names - {"experiment_id"}
                 if unknown:
                     raise ObservationError(f"unknown key(s) {sorted(unknown)}; parameters are "
-                                           f"{list(self.space.names)}, objectives {sorted(names)}")
-                params = {k: item[k] for k in self.space.names if k in item}
+                                           f"{list(self.parameter_names)}, objectives {sorted(names)}")
+                params = {k: item[k] for k in self.parameter_names if k in item}
                 objectives = {o.name: item.get(o.name) for o in self.objectives}
                 experiment_id, meta = item.get("experiment_id"), {}
         else:
@@ -184,13 +197,22 @@ class BasePlanner:
             raise ObservationError("'objectives' must be a mapping or null")
         if experiment_id is not None and not isinstance(experiment_id, str):
             raise ObservationError(f"experiment_id must be a string, got {experiment_id!r}")
-        unknown = set(params) - set(self.space.names)
+        unknown = set(params) - set(self.parameter_names)
         if unknown:
-            raise ObservationError(f"unknown parameter(s) {sorted(unknown)}; parameters are {list(self.space.names)}")
+            raise ObservationError(
+                f"unknown parameter(s) {sorted(unknown)}; parameters are {list(self.parameter_names)}")
         X = self.space.to_internal([params])
         clean = self.space.to_params(X)[0]
         for d in self.space.cont_idx:  # keep the caller's exact continuous values, not a unit round trip
             clean[self.space.names[d]] = float(params[self.space.names[d]])
+        if self.equalities:
+            missing = [n for n in self.equalities.dependent if n not in params]
+            if missing:
+                raise ObservationError(f"missing parameter(s) {missing}")
+            self.config.space.to_internal([params])  # types and bounds of the solved parameters too
+            self.equalities.check(params)
+            clean = {n: (float(params[n]) if n in self.equalities.dependent else clean[n])
+                     for n in self.parameter_names}
         known = {o.name for o in self.objectives}
         extra = set(objectives) - known
         if extra:
@@ -263,7 +285,7 @@ class BasePlanner:
         self._ask_count += 1
         proposals = []
         for strategy, params in zip(strategies, self.space.to_params(points)):
-            proposal = Proposal(str(uuid.uuid4()), params, strategy)
+            proposal = Proposal(str(uuid.uuid4()), self._complete(params), strategy)
             self.pending[proposal.experiment_id] = proposal
             proposals.append(proposal)
         return proposals
