@@ -9,7 +9,7 @@ from __future__ import annotations
 import csv
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
@@ -22,6 +22,9 @@ from .space import SearchSpace
 
 PLUGIN_GROUP = "gryffin_ros.constraints"
 ENUMERATION_LIMIT = 10**6
+# Feasible Monte Carlo hits kept from the V_C estimate (all of them, up to this many) as hit-and-run seeds: a region
+# 1000x smaller than the rest still holds a few of 20 000 draws.
+KEPT_HITS = 50_000
 
 
 @dataclass
@@ -270,8 +273,10 @@ class FeasibleFraction:
 
     value: float
     stderr: float
-    method: str  # "given" | "unconstrained" | "enumerated" | "monte_carlo"
+    method: str  # "given" | "unconstrained" | "enumerated" | "monte_carlo" | "upper_bound"
     samples: int = 0
+    # feasible points met while estimating (uniform Monte Carlo hits): seeds for the hit-and-run sampler
+    points: np.ndarray | None = field(default=None, compare=False, repr=False)
 
 
 def estimate_feasible_fraction(constraints: KnownConstraints, rng: np.random.Generator,
@@ -293,9 +298,13 @@ def estimate_feasible_fraction(constraints: KnownConstraints, rng: np.random.Gen
         if hits == 0:
             raise NoFeasiblePointError(f"none of the {size} points of the search space satisfies the known constraints")
         return FeasibleFraction(hits / size, 0.0, "enumerated", size)
-    hits, drawn, batch = 0, 0, samples
+    hits, drawn, batch, kept = 0, 0, samples, []
     while True:
-        hits += int(constraints.feasible(space.sample(rng, batch)).sum())
+        X = space.sample(rng, batch)
+        ok = constraints.feasible(X)
+        hits += int(ok.sum())
+        if sum(len(k) for k in kept) < KEPT_HITS:
+            kept.append(X[ok][:KEPT_HITS])
         drawn += batch
         if hits >= 10 or drawn >= max_samples:
             break
@@ -305,4 +314,4 @@ def estimate_feasible_fraction(constraints: KnownConstraints, rng: np.random.Gen
             f"no point satisfying the known constraints was found in {drawn} uniform samples of the domain "
             f"(feasible fraction below ~{1 / drawn:.1e}); check that the constraints do not contradict each other")
     p = hits / drawn
-    return FeasibleFraction(p, math.sqrt(p * (1 - p) / drawn), "monte_carlo", drawn)
+    return FeasibleFraction(p, math.sqrt(p * (1 - p) / drawn), "monte_carlo", drawn, np.concatenate(kept))

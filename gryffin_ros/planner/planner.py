@@ -29,7 +29,7 @@ from .errors import ConfigError, ExhaustedSpaceError, NoFeasiblePointError, Obse
 from .feasibility import FeasibilityModel, combine
 from .genetic import GeneticOptimizer
 from .kernel_density import KernelDensity
-from .sampling import perturb, rejection_sample
+from .sampling import hit_and_run, perturb, rejection_sample, spread_seeds
 from .selection import duplicates, select
 
 STATE_FORMAT = 1
@@ -42,6 +42,11 @@ EXHAUSTIVE_LIMIT = 20_000
 # and every candidate needs every kernel (n = 1000, d = 10: 1.4 s per ask instead of 0.2 s).
 SPACING_FACTOR = 16.0
 AUTO_SPACING_MAX_DIMS = 4
+# Start points: hit-and-run chains from up to SPREAD_SEEDS known feasible points chosen far apart, at least
+# WALK_POINTS_PER_SEED points each; V_C from at most MAX_VC_SAMPLES uniform draws.
+SPREAD_SEEDS = 16
+WALK_POINTS_PER_SEED = 8
+MAX_VC_SAMPLES = 2_000_000
 ConstraintArg = Callable[[dict], bool] | Sequence[Callable[[dict], bool]] | None
 
 
@@ -152,8 +157,25 @@ class BasePlanner:
             else:
                 # a stream of its own that depends on the seed alone: V_C must not change with campaign progress
                 rng = np.random.default_rng([self.seed, 1])
-                self._feasible_fraction = estimate_feasible_fraction(self.constraints, rng)
+                try:
+                    self._feasible_fraction = estimate_feasible_fraction(self.constraints, rng,
+                                                                         max_samples=MAX_VC_SAMPLES)
+                except NoFeasiblePointError:
+                    if not self.observations:
+                        raise
+                    # uniform sampling found nothing, but reported experiments are feasible points: V_C is below
+                    # ~1/draws; proposals come from hit-and-run chains started at those experiments
+                    self._feasible_fraction = FeasibleFraction(1.0 / MAX_VC_SAMPLES, 0.0, "upper_bound",
+                                                               MAX_VC_SAMPLES)
         return self._feasible_fraction
+
+    def feasible_pool(self) -> np.ndarray:
+        """Known feasible points: uniform hits met while estimating V_C, observed and pending experiments."""
+        fraction = self.feasible_fraction
+        parts = [self.observed_points(), self.pending_points()]
+        if fraction.points is not None:
+            parts.append(fraction.points)
+        return np.concatenate(parts)
 
     def feasible_set(self) -> np.ndarray | None:
         """Every feasible point of a finite space small enough to search exhaustively, else None (cached)."""
@@ -324,6 +346,13 @@ class BasePlanner:
                     chosen = np.concatenate([chosen, x[None]])
             if len(chosen) == n:
                 return chosen
+        # uniform draws are too rare to hit the feasible set: walk inside it from the feasible points known so far
+        seeds = spread_seeds(self.space, self.feasible_pool(), SPREAD_SEEDS, rng)
+        for x in hit_and_run(self.constraints, rng, seeds, 20 * n):
+            if len(chosen) < n and not duplicates(self.space, x[None], np.concatenate([avoid, chosen]))[0]:
+                chosen = np.concatenate([chosen, x[None]])
+        if len(chosen) == n:
+            return chosen
         raise NoFeasiblePointError(
             f"could not draw {n} new feasible point(s) within {self.config.general.max_rejection_draws} uniform "
             f"samples per try (estimated feasible fraction {self.feasible_fraction.value:.2e})")
@@ -384,7 +413,14 @@ class Planner(BasePlanner):
         m = self.config.general.num_random_samples * self.space.dim
         uniform = rejection_sample(self.constraints, rng, m, self.config.general.max_rejection_draws,
                                    self.feasible_fraction.value)
-        start = np.concatenate([uniform, perturb(self.constraints, rng, incumbent, m)])
+        # hit-and-run chains from spread-out known feasible points: they fill in when uniform draws are rare (tiny
+        # feasible sets) and give every separate feasible region found a share of start points, however small
+        walked = np.empty((0, self.space.dim))
+        if self.constraints:
+            seeds = spread_seeds(self.space, self.feasible_pool(), SPREAD_SEEDS, rng)
+            walked = hit_and_run(self.constraints, rng, seeds,
+                                 max(m - len(uniform), WALK_POINTS_PER_SEED * len(seeds)))
+        start = np.concatenate([uniform, walked, perturb(self.constraints, rng, incumbent, m)])
         if len(uniform) < m:
             start = np.concatenate([start, feasible_observed])
         return start, False
