@@ -23,6 +23,7 @@ import torch
 from gryffin_ros.planner import Planner, vectorized
 from gryffin_ros.planner.acquisition import Acquisition
 from gryffin_ros.planner.kernel_density import KernelDensity
+from gryffin_ros.planner.planner import SPACING_FACTOR
 
 DIMS = (1, 2, 3, 4, 6, 8, 10)
 NUM_OBS = (10, 100, 200, 300, 400, 500)
@@ -55,7 +56,8 @@ def time_case(d: int, n: int, constrained: bool, optimizer: str, repeats: int) -
         X = planner.observed_points()
         merits = planner.merits(planner.observations)
         density = KernelDensity(planner.space, X, merits, planner.feasible_fraction.value,
-                                torch.Generator().manual_seed(r))
+                                torch.Generator().manual_seed(r), spacing_scaled=planner.spacing_kernels,
+                                spacing_factor=SPACING_FACTOR)
         for s in acq:
             tick = time.perf_counter()
             start, _ = planner._start_points(rng, X[int(np.argmin(merits))], X)
