@@ -34,6 +34,8 @@ class NamedConstraint:
     name: str
     fn: Callable[[dict], Any]
     columns_fn: Callable[[Mapping[str, np.ndarray]], np.ndarray] | None = None
+    # when the constraint is exactly a set of linear half-spaces sum(coefs * x) <= rhs in users' units
+    linear: list[tuple[dict[str, float], float]] | None = None
 
 
 def expression_constraint(options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
@@ -203,6 +205,12 @@ class KnownConstraints:
         """`names`: every parameter name a constraint may use (default: the space's)."""
         names = space.names if names is None else names
         constraints = [constraint_from_spec(s, i, names) for i, s in enumerate(specs)]
+        from .equalities import linear_inequalities  # (equalities imports this module)
+        continuous = {p.name for p in space.parameters if p.kind == "continuous"}
+        for spec, constraint in zip(specs, constraints):
+            text = spec if isinstance(spec, str) else (spec.get("expression") if isinstance(spec, Mapping) else None)
+            if isinstance(text, str):
+                constraint.linear = linear_inequalities(text, continuous)
         if callables is not None:
             fns = [callables] if callable(callables) else list(callables)
             for i, fn in enumerate(fns):
@@ -213,6 +221,25 @@ class KnownConstraints:
 
     def __bool__(self) -> bool:
         return bool(self.constraints)
+
+    def halfspaces(self) -> tuple[np.ndarray, np.ndarray, bool] | None:
+        """The linear constraints as A u <= b over the internal coordinates (all dims; finite dims get 0), and whether
+        they are all the constraints there are; None when no constraint is linear."""
+        rows, rhs = [], []
+        for c in self.constraints:
+            for coefs, bound in c.linear or []:
+                a = np.zeros(self.space.dim)
+                b = bound
+                for name, coef in coefs.items():
+                    d = self.space.names.index(name)
+                    p = self.space.parameters[d]
+                    a[d] = coef * p.span  # x = low + span * u
+                    b -= coef * p.low
+                rows.append(a)
+                rhs.append(b)
+        if not rows:
+            return None
+        return np.array(rows), np.array(rhs), all(c.linear is not None for c in self.constraints)
 
     def feasible(self, X: np.ndarray) -> np.ndarray:
         """(M, D) internal points -> (M,) bool. A constraint that raises becomes a ConstraintError naming it."""

@@ -72,6 +72,40 @@ def _linear_form(node: ast.AST, names: set[str]) -> tuple[dict[str, float], floa
     raise _NotLinear(type(node).__name__)
 
 
+def linear_inequalities(text: str, continuous: set[str]) -> list[tuple[dict[str, float], float]] | None:
+    """An expression that is a conjunction of (possibly chained) <, <=, >, >= comparisons, every side linear in
+    continuous parameters -> half-spaces sum(coefs * x) <= rhs (strict ones taken as non-strict: they differ on a set
+    of volume zero); None for anything else."""
+    try:
+        body = ast.parse(text.strip(), mode="eval").body
+    except SyntaxError:
+        return None
+    parts = body.values if isinstance(body, ast.BoolOp) and isinstance(body.op, ast.And) else [body]
+    out: list[tuple[dict[str, float], float]] = []
+    try:
+        for part in parts:
+            if not isinstance(part, ast.Compare):
+                return None
+            sides = [_linear_form(node, continuous) for node in [part.left, *part.comparators]]
+            for op, (a, ca), (b, cb) in zip(part.ops, sides, sides[1:]):
+                if isinstance(op, (ast.Lt, ast.LtE)):
+                    small, c_small, big, c_big = a, ca, b, cb
+                elif isinstance(op, (ast.Gt, ast.GtE)):
+                    small, c_small, big, c_big = b, cb, a, ca
+                else:
+                    return None
+                coefs = dict(small)
+                for k, v in big.items():
+                    coefs[k] = coefs.get(k, 0.0) - v
+                coefs = {k: v for k, v in coefs.items() if v != 0.0}
+                if not coefs:
+                    return None
+                out.append((coefs, c_big - c_small))
+    except _NotLinear:
+        return None
+    return out
+
+
 def _equality_sides(text: str) -> tuple[ast.AST, ast.AST] | None:
     try:
         tree = ast.parse(text.strip(), mode="eval")
@@ -115,7 +149,10 @@ class LinearEqualities:
             if sides is None:
                 rest.append(spec)
                 continue
-            used = {n.id for side in sides for n in ast.walk(side) if isinstance(n, ast.Name)} & every
+            mentioned = {n.id for side in sides for n in ast.walk(side) if isinstance(n, ast.Name)}
+            used = mentioned & every
+            if used & continuous and mentioned - every:
+                raise ConfigError(f"{where} '{text}': unknown parameter(s) {sorted(mentioned - every)}")
             if not used & continuous:
                 rest.append(spec)  # an equality on finite parameters only: sampled like any expression
                 continue
@@ -263,7 +300,12 @@ class LinearEqualities:
             def one(params: Mapping[str, Any], fn=within) -> bool:
                 return bool(fn({k: np.asarray([v]) for k, v in params.items()})[0])
 
-            out.append(NamedConstraint(f"{name} = {self.formula(i)} within [{p.low:g}, {p.high:g}]", one, within))
+            constraint = NamedConstraint(f"{name} = {self.formula(i)} within [{p.low:g}, {p.high:g}]", one, within)
+            coefs = {n: float(c) for n, c in zip(self.free, self.matrix[i]) if c != 0.0}
+            # low <= offset - coefs.x <= high  <=>  coefs.x <= offset - low  and  -coefs.x <= high - offset
+            constraint.linear = [(coefs, float(self.offset[i] - p.low)),
+                                 ({k: -v for k, v in coefs.items()}, float(p.high - self.offset[i]))]
+            out.append(constraint)
         return out
 
     def formula(self, i: int) -> str:

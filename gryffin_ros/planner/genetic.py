@@ -92,7 +92,23 @@ def project_to_feasible(constraints: KnownConstraints, children: np.ndarray, par
     still = bad[~constraints.feasible(out[bad])]
     if not still.size:
         return out
-    # (ii) bisection between the feasible parent and the infeasible child on continuous/discrete dims
+    # (ii) all constraints linear and the segment continuous: the exact boundary point, t* = the largest t in
+    # [0, 1] with A (parent + t (child - parent)) <= b (a hair inside, then checked)
+    planes = constraints.halfspaces()
+    if planes is not None and planes[2] and not space.finite_idx.size:
+        A, b, _ = planes
+        start, step = parents[still], out[still] - parents[still]
+        slope = step @ A.T
+        with np.errstate(divide="ignore", invalid="ignore"):
+            limit = np.where(slope > 0, (b[None] - start @ A.T) / slope, np.inf)
+        t = np.clip(limit.min(axis=1), 0.0, 1.0) * (1.0 - 1e-9)
+        exact = space.clip(start + t[:, None] * step)
+        ok = constraints.feasible(exact)
+        out[still[ok]] = exact[ok]
+        still = still[~ok]
+        if not still.size:
+            return out
+    # (ii') otherwise bisection between the feasible parent and the infeasible child on continuous/discrete dims
     lo, hi = parents[still].copy(), out[still].copy()
     best = parents[still].copy()
     for _ in range(MAX_BISECTIONS):

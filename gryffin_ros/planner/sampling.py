@@ -67,10 +67,12 @@ def hit_and_run(constraints: KnownConstraints, rng: np.random.Generator, seeds: 
     """m feasible points from hit-and-run chains started at feasible `seeds` (one chain per seed, run in parallel).
 
     Each step picks a random direction in the continuous dims and samples the feasible chord through the current
-    point by slice sampling with shrinkage: a uniform draw on the in-box segment, and on an infeasible draw the segment
-    shrinks towards the current point (at most `shrinks` times; then the point stays). Uniform on the feasible set is
-    the chain's stationary distribution (each chain stays in the connected region of its seed). Finite dims take a
-    Metropolis step to a random option, kept when feasible. The seeds are returned first, then the chains' points in
+    point: the chord is cut exactly by the box and by the linear constraints (on a polytope every draw is feasible:
+    exact hit-and-run); any other constraint is handled by slice sampling with shrinkage: a uniform draw on the
+    chord, and on an infeasible draw the chord shrinks towards the current point (at most `shrinks` times; then the
+    point stays). Uniform on the feasible set is the chain's stationary distribution; a chain can jump between
+    regions that one line crosses. Finite dims take a Metropolis step to a random option, kept when feasible. The
+    seeds are returned first, then the chains' points in
     random order. Only feasible points are ever returned; with no seeds, nothing is returned.
     """
     space = constraints.space
@@ -79,6 +81,8 @@ def hit_and_run(constraints: KnownConstraints, rng: np.random.Generator, seeds: 
     chains = int(min(len(seeds), m))
     X = seeds[rng.permutation(len(seeds))[:chains]].copy()
     c, f = space.cont_idx, space.finite_idx
+    planes = constraints.halfspaces()
+    linear = None if planes is None else planes[:2]
     out = []
     per_chain_steps = max(steps, int(np.ceil(m / chains)))
     for _ in range(per_chain_steps):
@@ -91,6 +95,15 @@ def hit_and_run(constraints: KnownConstraints, rng: np.random.Generator, seeds: 
                 to_high = np.where(direction != 0, (1.0 - X[:, c]) / direction, np.inf)
             lo = np.max(np.minimum(to_low, to_high), axis=1)
             hi = np.min(np.maximum(to_low, to_high), axis=1)
+            if linear is not None:  # exact chord through the linear half-spaces: A (x + t v) <= b
+                A, b = linear
+                slope = direction @ A[:, c].T  # (chains, rows)
+                slack = b[None] - X @ A.T
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    limit = slack / slope
+                hi = np.minimum(hi, np.where(slope > 0, limit, np.inf).min(axis=1))
+                lo = np.maximum(lo, np.where(slope < 0, limit, -np.inf).max(axis=1))
+                hi = np.maximum(hi, lo)  # a seed on the boundary (rounding): an empty chord, the point stays
             pending = np.ones(chains, dtype=bool)
             for _ in range(shrinks):
                 idx = np.flatnonzero(pending)

@@ -74,6 +74,7 @@ def test_observations_must_satisfy_the_equalities():
 @pytest.mark.parametrize("constraints, message", [
     (["a + b == 1", "a + b == 2"], "contradict"),
     (["a * b == 1"], "only linear"),
+    (["a + c == 1"], "unknown parameter"),
     (["a + n == 3"], "continuous parameters only"),
     (["a == 0.5", "b == 0.2"], "fix every parameter"),
     ([{"mixture": {"components": ["a", "n"]}}], "not continuous"),
