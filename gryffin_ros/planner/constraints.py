@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ConfigError, ConstraintError, NoFeasiblePointError
-from .expressions import Expression
+from .expressions import Expression, linear_inequalities
 from .space import SearchSpace
 
 PLUGIN_GROUP = "gryffin_ros.constraints"
@@ -205,7 +205,6 @@ class KnownConstraints:
         """`names`: every parameter name a constraint may use (default: the space's)."""
         names = space.names if names is None else names
         constraints = [constraint_from_spec(s, i, names) for i, s in enumerate(specs)]
-        from .equalities import linear_inequalities  # (equalities imports this module)
         continuous = {p.name for p in space.parameters if p.kind == "continuous"}
         for spec, constraint in zip(specs, constraints):
             text = spec if isinstance(spec, str) else (spec.get("expression") if isinstance(spec, Mapping) else None)

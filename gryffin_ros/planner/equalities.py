@@ -30,80 +30,11 @@ import numpy as np
 
 from .constraints import NamedConstraint
 from .errors import ConfigError, ObservationError
+from .expressions import NotLinear, difference, linear_form
 from .space import SearchSpace
 
 # Relative tolerance when checking that a reported observation satisfies the equalities.
 OBSERVATION_TOLERANCE = 1e-6
-
-
-class _NotLinear(Exception):
-    pass
-
-
-def _linear_form(node: ast.AST, names: set[str]) -> tuple[dict[str, float], float]:
-    """An expression node -> (coefficients by parameter name, constant); raises _NotLinear otherwise."""
-    if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
-        return {}, float(node.value)
-    if isinstance(node, ast.Name):
-        if node.id not in names:
-            raise _NotLinear(node.id)
-        return {node.id: 1.0}, 0.0
-    if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
-        coefs, const = _linear_form(node.operand, names)
-        sign = -1.0 if isinstance(node.op, ast.USub) else 1.0
-        return {k: sign * v for k, v in coefs.items()}, sign * const
-    if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Add, ast.Sub)):
-        (a, ca), (b, cb) = _linear_form(node.left, names), _linear_form(node.right, names)
-        sign = 1.0 if isinstance(node.op, ast.Add) else -1.0
-        out = dict(a)
-        for k, v in b.items():
-            out[k] = out.get(k, 0.0) + sign * v
-        return out, ca + sign * cb
-    if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Mult, ast.Div)):
-        (a, ca), (b, cb) = _linear_form(node.left, names), _linear_form(node.right, names)
-        if isinstance(node.op, ast.Div):
-            if b or cb == 0:
-                raise _NotLinear("division by a parameter or by zero")
-            return {k: v / cb for k, v in a.items()}, ca / cb
-        if a and b:
-            raise _NotLinear("product of parameters")
-        scale, (coefs, const) = (ca, (b, cb)) if not a else (cb, (a, ca))
-        return {k: scale * v for k, v in coefs.items()}, scale * const
-    raise _NotLinear(type(node).__name__)
-
-
-def linear_inequalities(text: str, continuous: set[str]) -> list[tuple[dict[str, float], float]] | None:
-    """An expression that is a conjunction of (possibly chained) <, <=, >, >= comparisons, every side linear in
-    continuous parameters -> half-spaces sum(coefs * x) <= rhs (strict ones taken as non-strict: they differ on a set
-    of volume zero); None for anything else."""
-    try:
-        body = ast.parse(text.strip(), mode="eval").body
-    except SyntaxError:
-        return None
-    parts = body.values if isinstance(body, ast.BoolOp) and isinstance(body.op, ast.And) else [body]
-    out: list[tuple[dict[str, float], float]] = []
-    try:
-        for part in parts:
-            if not isinstance(part, ast.Compare):
-                return None
-            sides = [_linear_form(node, continuous) for node in [part.left, *part.comparators]]
-            for op, (a, ca), (b, cb) in zip(part.ops, sides, sides[1:]):
-                if isinstance(op, (ast.Lt, ast.LtE)):
-                    small, c_small, big, c_big = a, ca, b, cb
-                elif isinstance(op, (ast.Gt, ast.GtE)):
-                    small, c_small, big, c_big = b, cb, a, ca
-                else:
-                    return None
-                coefs = dict(small)
-                for k, v in big.items():
-                    coefs[k] = coefs.get(k, 0.0) - v
-                coefs = {k: v for k, v in coefs.items() if v != 0.0}
-                if not coefs:
-                    return None
-                out.append((coefs, c_big - c_small))
-    except _NotLinear:
-        return None
-    return out
 
 
 def _equality_sides(text: str) -> tuple[ast.AST, ast.AST] | None:
@@ -160,14 +91,11 @@ class LinearEqualities:
                 raise ConfigError(f"{where} '{text}': an equality may mix continuous parameters only; "
                                   f"{sorted(used - continuous)} are discrete or categorical")
             try:
-                (a, ca), (b, cb) = (_linear_form(side, continuous) for side in sides)
-            except _NotLinear as exc:
+                (a, ca), (b, cb) = (linear_form(side, continuous) for side in sides)
+            except NotLinear as exc:
                 raise ConfigError(f"{where} '{text}': only linear equalities of continuous parameters can be "
                                   f"satisfied exactly (not linear: {exc})") from None
-            coefs = dict(a)
-            for k, v in b.items():
-                coefs[k] = coefs.get(k, 0.0) - v
-            coefs = {k: v for k, v in coefs.items() if v != 0.0}
+            coefs = difference(a, b)
             if not coefs:
                 raise ConfigError(f"{where} '{text}': no parameter is left after simplification")
             rows.append((coefs, cb - ca, text))
@@ -209,7 +137,7 @@ class LinearEqualities:
                                for v in pair) or pair[0] > pair[1]):
                 raise ConfigError(f"{where}: mixture bound for '{name}' must be [low, high] with low <= high")
             extra_constraints.append(f"{float(pair[0])!r} <= {name} <= {float(pair[1])!r}")
-        text = f"{' + '.join(components)} == {float(total)!r}"
+        text = str(spec.get("name") or f"{' + '.join(components)} == {float(total)!r}")
         return [({c: 1.0 for c in components}, float(total), text)], extra_constraints
 
     @classmethod

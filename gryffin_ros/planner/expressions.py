@@ -151,3 +151,79 @@ class Expression:
             raise self._reject(node, f"{node.func.id}() with {len(node.args)} argument(s)")
         args = [self._compile(a) for a in node.args]
         return lambda cols: fn(*[np.asarray(a(cols), dtype=float) for a in args])
+
+
+# ---- linear forms (equalities solved exactly; linear inequalities as half-spaces) ------------------------
+class NotLinear(Exception):
+    """An expression that is not a linear form of the given parameters."""
+
+
+def linear_form(node: ast.AST, names: set[str]) -> tuple[dict[str, float], float]:
+    """An expression node -> (coefficients by parameter name, constant); raises NotLinear otherwise."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
+        return {}, float(node.value)
+    if isinstance(node, ast.Name):
+        if node.id not in names:
+            raise NotLinear(node.id)
+        return {node.id: 1.0}, 0.0
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+        coefs, const = linear_form(node.operand, names)
+        sign = -1.0 if isinstance(node.op, ast.USub) else 1.0
+        return {k: sign * v for k, v in coefs.items()}, sign * const
+    if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Add, ast.Sub)):
+        (a, ca), (b, cb) = linear_form(node.left, names), linear_form(node.right, names)
+        sign = 1.0 if isinstance(node.op, ast.Add) else -1.0
+        out = dict(a)
+        for k, v in b.items():
+            out[k] = out.get(k, 0.0) + sign * v
+        return out, ca + sign * cb
+    if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Mult, ast.Div)):
+        (a, ca), (b, cb) = linear_form(node.left, names), linear_form(node.right, names)
+        if isinstance(node.op, ast.Div):
+            if b or cb == 0:
+                raise NotLinear("division by a parameter or by zero")
+            return {k: v / cb for k, v in a.items()}, ca / cb
+        if a and b:
+            raise NotLinear("product of parameters")
+        scale, (coefs, const) = (ca, (b, cb)) if not a else (cb, (a, ca))
+        return {k: scale * v for k, v in coefs.items()}, scale * const
+    raise NotLinear(type(node).__name__)
+
+
+def difference(a: Mapping[str, float], b: Mapping[str, float]) -> dict[str, float]:
+    """Coefficients of (a - b), without the parameters that cancel."""
+    out = dict(a)
+    for k, v in b.items():
+        out[k] = out.get(k, 0.0) - v
+    return {k: v for k, v in out.items() if v != 0.0}
+
+
+def linear_inequalities(text: str, continuous: set[str]) -> list[tuple[dict[str, float], float]] | None:
+    """An expression that is a conjunction of (possibly chained) <, <=, >, >= comparisons, every side linear in
+    continuous parameters -> half-spaces sum(coefs * x) <= rhs (strict ones taken as non-strict: they differ on a set
+    of volume zero); None for anything else."""
+    try:
+        body = ast.parse(text.strip(), mode="eval").body
+    except SyntaxError:
+        return None
+    parts = body.values if isinstance(body, ast.BoolOp) and isinstance(body.op, ast.And) else [body]
+    out: list[tuple[dict[str, float], float]] = []
+    try:
+        for part in parts:
+            if not isinstance(part, ast.Compare):
+                return None
+            sides = [linear_form(node, continuous) for node in [part.left, *part.comparators]]
+            for op, (a, ca), (b, cb) in zip(part.ops, sides, sides[1:]):
+                if isinstance(op, (ast.Lt, ast.LtE)):
+                    small, c_small, big, c_big = a, ca, b, cb
+                elif isinstance(op, (ast.Gt, ast.GtE)):
+                    small, c_small, big, c_big = b, cb, a, ca
+                else:
+                    return None
+                coefs = difference(small, big)
+                if not coefs:
+                    return None
+                out.append((coefs, c_big - c_small))
+    except NotLinear:
+        return None
+    return out

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from gryffin_ros.planner import KnownConstraints, SearchSpace
-from gryffin_ros.planner.equalities import linear_inequalities
+from gryffin_ros.planner.expressions import linear_inequalities
 from gryffin_ros.planner.genetic import project_to_feasible
 from gryffin_ros.planner.sampling import hit_and_run
 
