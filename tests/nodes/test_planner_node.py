@@ -136,3 +136,35 @@ def test_bad_start_up_parameters_exit_with_a_message(tmp_path):
                              f"config:={config}", "-p", "storage:=\":memory:\""], env=env, capture_output=True,
                             text=True, timeout=60)
     assert result.returncode == 2 and "no point satisfying the known constraints" in result.stderr
+
+
+BLEND_CONFIG = {
+    "name": "blend_test",
+    "parameters": [{"name": n, "type": "continuous", "low": 0.0, "high": 1.0} for n in ("water", "ethanol", "dmso")]
+    + [{"name": "T", "type": "continuous", "low": 20.0, "high": 90.0}],
+    "objectives": [{"name": "yield", "goal": "max"}],
+    "constraints": [{"mixture": {"components": ["water", "ethanol", "dmso"], "bounds": {"dmso": [0.0, 0.6]}}},
+                    "T < 100 - 22 * ethanol"],
+}
+
+
+def test_mixture_campaign_over_ros_proposes_exact_blends_and_names_a_broken_one(client, start_planner, tmp_path):
+    start_planner(BLEND_CONFIG, auto_propose=False)
+    proposals = [json.loads(client.recommend().message)["proposals"][0] for _ in range(3)]
+    for proposal in proposals:
+        p = proposal["params"]
+        assert list(p) == ["water", "ethanol", "dmso", "T"]
+        assert abs(p["water"] + p["ethanol"] + p["dmso"] - 1.0) <= 1e-9 and p["dmso"] <= 0.6
+    client.wait_matched()
+    start = len(client.wait_events(0))
+    first, second, third = proposals
+    client.publish({"experiment_id": first["experiment_id"], "params": first["params"], "objectives": {"yield": 40.0}})
+    broken = {**second["params"], "dmso": second["params"]["dmso"] + 0.05}
+    client.publish({"experiment_id": second["experiment_id"], "params": broken, "objectives": {"yield": 50.0}})
+    missing = {k: v for k, v in third["params"].items() if k != "dmso"}
+    client.publish({"experiment_id": third["experiment_id"], "params": missing, "objectives": {"yield": 50.0}})
+    events = client.wait_events(start + 3)[start:]
+    assert events[0]["type"] == "observation_accepted", events
+    assert events[1]["type"] == "observation_rejected" and "water + ethanol + dmso == 1.0" in events[1]["reason"]
+    assert events[2]["type"] == "observation_rejected" and "missing parameter(s) ['dmso']" in events[2]["reason"]
+    assert stored_ids(tmp_path / "campaign.sqlite") == [first["experiment_id"]]
