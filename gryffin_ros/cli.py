@@ -46,12 +46,19 @@ class Progress:
             print(flush=True)
 
 
-def best_value(config: PlannerConfig, store: CampaignStore) -> tuple[int, dict[str, float] | None]:
-    """Experiments so far and the objectives of the best one (by the campaign's merit, Chimera included)."""
-    planner = Planner(config, seed=0)
-    planner.tell(store.observations())
-    best = planner.best()
-    return len(planner.observations), None if best is None else best.objectives
+class BestSoFar:
+    """Experiments so far and the objectives of the best one (by the campaign's merit, Chimera included); each call
+    reads only the observations stored since the last one."""
+
+    def __init__(self, config: PlannerConfig):
+        self.planner = Planner(config, seed=0)
+
+    def __call__(self, store: CampaignStore) -> tuple[int, dict[str, float] | None]:
+        new = store.observations(skip=len(self.planner.observations))
+        if new:
+            self.planner.tell(new)
+        best = self.planner.best()
+        return len(self.planner.observations), None if best is None else best.objectives
 
 
 def emulator_settings(config: PlannerConfig) -> tuple[str, list[str], list[str]]:
@@ -129,10 +136,11 @@ def run_ros(config_path: str, config: PlannerConfig, store: CampaignStore, args:
     logs = [open(out / "planner_node.log", "w"), open(out / f"{kind}_node.log", "w")]
     processes = [subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT)
                  for cmd, log in zip((planner_cmd, emulator_cmd), logs)]
+    best_value = BestSoFar(config)
     try:
         done, last_change = -1, time.monotonic()
         while True:
-            count, best = best_value(config, store)
+            count, best = best_value(store)
             progress.show(count, best)
             if count >= args.budget:
                 return
@@ -196,7 +204,7 @@ def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespa
         rows = store.export_csv(out / "experiments.csv")
         if rows:
             plot(store, config, out / "best_so_far.png")
-        count, best = best_value(config, store) if rows else (0, None)
+        count, best = BestSoFar(config)(store) if rows else (0, None)
         store.close()
     print(f"{rows} experiment(s): {out / 'experiments.csv'}, {out / 'best_so_far.png'}, {out / 'campaign.sqlite'}")
     return count, best, interrupted

@@ -129,8 +129,10 @@ class CampaignStore:
         rows = self._query("SELECT experiment_id, params, strategy FROM proposals ORDER BY created, rowid")
         return [Proposal(eid, json.loads(params), strategy) for eid, params, strategy in rows]
 
-    def observations(self) -> list[Observation]:
-        rows = self._query("SELECT experiment_id, params, objectives, meta FROM observations ORDER BY seq")
+    def observations(self, skip: int = 0) -> list[Observation]:
+        """The stored observations in arrival order, after the first `skip` of them."""
+        rows = self._query("SELECT experiment_id, params, objectives, meta FROM observations ORDER BY seq "
+                           "LIMIT -1 OFFSET ?", (int(skip),))
         return [Observation(json.loads(p), json.loads(o), eid, json.loads(m)) for eid, p, o, m in rows]
 
     def pending(self) -> list[Proposal]:

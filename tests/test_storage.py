@@ -21,6 +21,7 @@ def test_observations_survive_reopening_in_order(tmp_path):
     reopened = CampaignStore(path, CONFIG, "h1")
     assert [o.experiment_id for o in reopened.observations()] == ["b", "a"]
     assert reopened.observations()[1].failed
+    assert [o.experiment_id for o in reopened.observations(skip=1)] == ["a"] and not reopened.observations(skip=2)
     assert [p.experiment_id for p in reopened.pending()] == ["c"]
     assert reopened.get_meta("config_hash") == "h1"
 
