@@ -50,6 +50,7 @@ class GeneralSettings:
     feas_param: float = 1.0
     auto_desc_gen: bool = False
     kernel_width: str = "auto"
+    concrete_temperature: float = 3.0
 
 
 _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
@@ -57,7 +58,7 @@ _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
     "acquisition_optimizer": (str,), "obj_transform": (str,), "feasible_fraction": (int, float),
     "random_seed": (int,), "max_rejection_draws": (int,), "softness": (int, float),
     "feas_approach": (str,), "feas_param": (int, float), "auto_desc_gen": (bool,),
-    "kernel_width": (str,),
+    "kernel_width": (str,), "concrete_temperature": (int, float),
 }
 _GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"}, "obj_transform": {"sqrt", "identity"},
                     "feas_approach": {"fwa", "fia", "fca"}, "kernel_width": {"auto", "spacing", "gryffin"}}
@@ -123,6 +124,10 @@ def _general(spec: Any) -> GeneralSettings:
             raise ConfigError(f"'general.{key}' must be at least 1, got {values[key]}")
     if "softness" in values and not (values["softness"] >= 0 and math.isfinite(values["softness"])):
         raise ConfigError(f"'general.softness' must be a non-negative number, got {values['softness']}")
+    if "concrete_temperature" in values and not (values["concrete_temperature"] > 0
+                                                 and math.isfinite(values["concrete_temperature"])):
+        raise ConfigError("'general.concrete_temperature' must be a positive number, got "
+                          f"{values['concrete_temperature']}")
     if "feas_param" in values and not (values["feas_param"] >= 0 and math.isfinite(values["feas_param"])):
         raise ConfigError(f"'general.feas_param' must be a non-negative number, got {values['feas_param']}")
     fraction = values.get("feasible_fraction")

@@ -7,7 +7,8 @@ the Gaussian becomes a Student-t with 2a >= 24 degrees of freedom and scale 1/sq
 all squared distances come from one matrix product instead of an (M, N, D) tensor. Those kernels are so narrow that
 between observations only the uniform term is left, so the planner's default (general.kernel_width = spacing) uses
 precision 16 rho^(2/C) instead: kernels a quarter of the typical data spacing wide. Finite dims: concrete
-(Gumbel-softmax) draws with temperature 0.5 + 10/rho, reshaped by descriptor distance, averaged over draws into one
+(Gumbel-softmax) draws with temperature 0.5 + c/rho (Gryffin's c = 10; general.concrete_temperature, default 3),
+reshaped by descriptor distance, averaged over draws into one
 probability table per dim.
 """
 
@@ -81,11 +82,12 @@ class KernelDensity:
 
     def __init__(self, space: SearchSpace, X: np.ndarray, merits: np.ndarray, feasible_fraction: float,
                  generator: torch.Generator, spacing_scaled: bool = False, spacing_factor: float = 1.0,
-                 descriptors: Mapping[int, np.ndarray] | None = None):
+                 descriptors: Mapping[int, np.ndarray] | None = None, temperature_scale: float = 10.0):
         """spacing_scaled: continuous precision spacing_factor * rho^(2/C) (C continuous dims), i.e. kernel width =
         the typical spacing of rho points in C dims over sqrt(spacing_factor), instead of Gryffin's 12 rho^2 (the
         planner's default, general.kernel_width = spacing, uses factor 16; the classifier of failed experiments 1).
-        descriptors: learned descriptor tables replacing the space's for some finite dims (dynamic descriptors)."""
+        descriptors: learned descriptor tables replacing the space's for some finite dims (dynamic descriptors).
+        temperature_scale: c in the concrete temperature 0.5 + c / rho (Gryffin: 10; the planner's default 3)."""
         self.space = space
         locations, values = mirror(space, X, merits)
         self.n_kernels = len(locations)
@@ -101,7 +103,7 @@ class KernelDensity:
                           else 12.0 * self.rho ** 2)
         self._log_norm = 0.5 * len(c) * math.log(self.precision / (2 * math.pi))
         self._loc_sq = (self.loc ** 2).sum(1)  # (N,)
-        temperature = 0.5 + 10.0 / self.rho
+        temperature = 0.5 + temperature_scale / self.rho
         self.tables = [
             torch.log(concrete_table(locations[:, d].astype(int), int(space.n_options[d]), temperature,
                                      (descriptors or {}).get(d, space.descriptors(d)), generator).clamp_min(1e-300))

@@ -496,8 +496,8 @@ class Planner(BasePlanner):
         merits = self.merits(successful)
         descriptors = {d: r.table for d, r in self.learned_descriptors(X, merits).items()}
         density = KernelDensity(self.space, X, merits, self.feasible_fraction.value, generator,
-                                spacing_scaled=self.spacing_kernels,
-                                spacing_factor=SPACING_FACTOR, descriptors=descriptors)
+                                spacing_scaled=self.spacing_kernels, spacing_factor=SPACING_FACTOR,
+                                descriptors=descriptors, temperature_scale=self.config.general.concrete_temperature)
         start, exhaustive = self._start_points(rng, X[int(np.argmin(merits))], X)
         general = self.config.general
         values = self.strategy_values()
