@@ -50,7 +50,7 @@ class GeneralSettings:
     feas_param: float = 1.0
     auto_desc_gen: bool = False
     kernel_width: str = "auto"
-    concrete_temperature: float = 3.0
+    concrete_temperature: float = 0.0
 
 
 _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
@@ -124,9 +124,9 @@ def _general(spec: Any) -> GeneralSettings:
             raise ConfigError(f"'general.{key}' must be at least 1, got {values[key]}")
     if "softness" in values and not (values["softness"] >= 0 and math.isfinite(values["softness"])):
         raise ConfigError(f"'general.softness' must be a non-negative number, got {values['softness']}")
-    if "concrete_temperature" in values and not (values["concrete_temperature"] > 0
+    if "concrete_temperature" in values and not (values["concrete_temperature"] >= 0
                                                  and math.isfinite(values["concrete_temperature"])):
-        raise ConfigError("'general.concrete_temperature' must be a positive number, got "
+        raise ConfigError("'general.concrete_temperature' must be a non-negative number, got "
                           f"{values['concrete_temperature']}")
     if "feas_param" in values and not (values["feas_param"] >= 0 and math.isfinite(values["feas_param"])):
         raise ConfigError(f"'general.feas_param' must be a non-negative number, got {values['feas_param']}")

@@ -7,7 +7,7 @@ the Gaussian becomes a Student-t with 2a >= 24 degrees of freedom and scale 1/sq
 all squared distances come from one matrix product instead of an (M, N, D) tensor. Those kernels are so narrow that
 between observations only the uniform term is left, so the planner's default (general.kernel_width = spacing) uses
 precision 16 rho^(2/C) instead: kernels a quarter of the typical data spacing wide. Finite dims: concrete
-(Gumbel-softmax) draws with temperature 0.5 + c/rho (Gryffin's c = 10; general.concrete_temperature, default 3),
+(Gumbel-softmax) draws with temperature 0.5 + c/rho (Gryffin's c = 10; general.concrete_temperature, default 0),
 reshaped by descriptor distance, averaged over draws into one
 probability table per dim.
 """
@@ -87,7 +87,7 @@ class KernelDensity:
         the typical spacing of rho points in C dims over sqrt(spacing_factor), instead of Gryffin's 12 rho^2 (the
         planner's default, general.kernel_width = spacing, uses factor 16; the classifier of failed experiments 1).
         descriptors: learned descriptor tables replacing the space's for some finite dims (dynamic descriptors).
-        temperature_scale: c in the concrete temperature 0.5 + c / rho (Gryffin: 10; the planner's default 3)."""
+        temperature_scale: c in the concrete temperature 0.5 + c / rho (Gryffin: 10; the planner's default 0)."""
         self.space = space
         locations, values = mirror(space, X, merits)
         self.n_kernels = len(locations)

@@ -128,16 +128,16 @@ def test_concrete_temperature_sets_how_sharply_a_few_observations_pin_their_opti
     space = SearchSpace.from_config([{"name": "n", "type": "discrete", "low": 0, "high": 20}])
     X = np.array([[14.0]])
     tables = {c: torch.exp(KernelDensity(space, X, np.zeros(1), 1.0, torch.Generator().manual_seed(0),
-                                         temperature_scale=c).tables[0][0]).numpy() for c in (10.0, 3.0)}
-    assert tables[3.0][14] > tables[10.0][14]
-    assert abs(int(np.argmax(tables[3.0])) - 14) < abs(int(np.argmax(tables[10.0])) - 14)  # less pull to the middle
+                                         temperature_scale=c).tables[0][0]).numpy() for c in (10.0, 0.0)}
+    assert tables[0.0][14] > tables[10.0][14]
+    assert abs(int(np.argmax(tables[0.0])) - 14) < abs(int(np.argmax(tables[10.0])) - 14)  # less pull to the middle
 
 
 def test_concrete_temperature_setting_is_validated_and_used():
     config = {"parameters": [{"name": "n", "type": "discrete", "low": 0, "high": 20}],
               "objectives": [{"name": "y", "goal": "min"}]}
-    assert Planner(config).config.general.concrete_temperature == 3.0
+    assert Planner(config).config.general.concrete_temperature == 0.0
     from gryffin_ros.planner import ConfigError
-    for bad in (0, -1.0, float("inf"), "warm"):
+    for bad in (-1.0, float("inf"), "warm"):
         with pytest.raises(ConfigError, match="concrete_temperature"):
             Planner({**config, "general": {"concrete_temperature": bad}})
