@@ -139,6 +139,24 @@ def load_plugin(name: str, options: Mapping[str, Any], names: Sequence[str]) -> 
     return NamedConstraint(getattr(constraint, "name", name), constraint, getattr(constraint, "evaluate_columns", None))
 
 
+def expression_text(spec: Any) -> str | None:
+    """The expression of a config entry given as a string or ``{expression: ...}`` (None for plugins and others)."""
+    if isinstance(spec, str):
+        return spec
+    if isinstance(spec, Mapping) and "plugin" not in spec and isinstance(spec.get("expression"), str):
+        return spec["expression"]
+    return None
+
+
+def line_limits(A: np.ndarray, b: np.ndarray, X: np.ndarray, V: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For the lines X + t V (rows, internal units), the interval [low, high] of t where A (X + t V) <= b holds
+    (-inf / +inf where no half-space bounds it)."""
+    slope = V @ A.T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        limit = (b[None] - X @ A.T) / slope
+    return np.where(slope < 0, limit, -np.inf).max(axis=1), np.where(slope > 0, limit, np.inf).min(axis=1)
+
+
 def constraint_from_spec(spec: Any, position: int, names: Sequence[str]) -> NamedConstraint:
     """A config entry: an expression string, ``{expression: ...}`` or ``{plugin: NAME, options: {...}}``."""
     if isinstance(spec, str):
@@ -207,8 +225,8 @@ class KnownConstraints:
         constraints = [constraint_from_spec(s, i, names) for i, s in enumerate(specs)]
         continuous = {p.name for p in space.parameters if p.kind == "continuous"}
         for spec, constraint in zip(specs, constraints):
-            text = spec if isinstance(spec, str) else (spec.get("expression") if isinstance(spec, Mapping) else None)
-            if isinstance(text, str):
+            text = expression_text(spec)
+            if text is not None:
                 constraint.linear = linear_inequalities(text, continuous)
         if callables is not None:
             fns = [callables] if callable(callables) else list(callables)

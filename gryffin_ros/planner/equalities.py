@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .constraints import NamedConstraint
+from .constraints import NamedConstraint, expression_text
 from .errors import ConfigError, ObservationError
 from .expressions import NotLinear, difference, linear_form
 from .space import SearchSpace
@@ -74,9 +74,8 @@ class LinearEqualities:
                 rows += mixture_rows
                 rest += bounds
                 continue
-            text = spec if isinstance(spec, str) else (spec.get("expression") if isinstance(spec, Mapping)
-                                                         and "plugin" not in spec else None)
-            sides = _equality_sides(text) if isinstance(text, str) else None
+            text = expression_text(spec)
+            sides = _equality_sides(text) if text is not None else None
             if sides is None:
                 rest.append(spec)
                 continue

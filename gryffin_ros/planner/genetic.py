@@ -16,7 +16,7 @@ import numpy as np
 from deap import base, creator, tools
 
 from .acquisition import Acquisition
-from .constraints import KnownConstraints
+from .constraints import KnownConstraints, line_limits
 from .space import SearchSpace
 
 TOURNAMENT_SIZE = 3
@@ -98,10 +98,7 @@ def project_to_feasible(constraints: KnownConstraints, children: np.ndarray, par
     if planes is not None and planes[2] and not space.finite_idx.size:
         A, b, _ = planes
         start, step = parents[still], out[still] - parents[still]
-        slope = step @ A.T
-        with np.errstate(divide="ignore", invalid="ignore"):
-            limit = np.where(slope > 0, (b[None] - start @ A.T) / slope, np.inf)
-        t = np.clip(limit.min(axis=1), 0.0, 1.0) * (1.0 - 1e-9)
+        t = np.clip(line_limits(A, b, start, step)[1], 0.0, 1.0) * (1.0 - 1e-9)
         exact = space.clip(start + t[:, None] * step)
         ok = constraints.feasible(exact)
         out[still[ok]] = exact[ok]

@@ -108,10 +108,10 @@ class BasePlanner:
         self.space = self.equalities.reduced_space(full) if self.equalities else full
         self.objectives = self.config.objectives
         self.constraints = KnownConstraints.build(self.space, specs, known_constraints, names=full.names)
-        if self.equalities:
-            self.constraints.constraints[:0] = self.equalities.bound_constraints(full)
-            self.constraints.complete_columns = self.equalities.complete_columns
-            self.constraints.complete_row = self._complete
+        if self.equalities:  # the solved parameters' bounds first; every check sees the solved parameters too
+            self.constraints = KnownConstraints(
+                self.space, self.equalities.bound_constraints(full) + self.constraints.constraints,
+                self.equalities.complete_columns, self._complete)
         self._known_constraints = known_constraints
         if seed is None:
             seed = self.config.general.random_seed
@@ -335,23 +335,25 @@ class BasePlanner:
                     f"{n} requested")
             return free[rng.choice(len(free), n, replace=False)]
         chosen = np.empty((0, self.space.dim))
+
+        def add_new(candidates: np.ndarray) -> bool:
+            """Take candidates that repeat neither `avoid` nor each other until n are chosen; True once they are."""
+            nonlocal chosen
+            for x in candidates:
+                if len(chosen) < n and not duplicates(self.space, x[None], np.concatenate([avoid, chosen]))[0]:
+                    chosen = np.concatenate([chosen, x[None]])
+            return len(chosen) == n
+
         for _ in range(20):
-            need = n - len(chosen)
-            X = rejection_sample(self.constraints, rng, 4 * need, self.config.general.max_rejection_draws,
+            X = rejection_sample(self.constraints, rng, 4 * (n - len(chosen)), self.config.general.max_rejection_draws,
                                  self.feasible_fraction.value)
             if not len(X):
                 break
-            for x in X:
-                if len(chosen) < n and not duplicates(self.space, x[None], np.concatenate([avoid, chosen]))[0]:
-                    chosen = np.concatenate([chosen, x[None]])
-            if len(chosen) == n:
+            if add_new(X):
                 return chosen
         # uniform draws are too rare to hit the feasible set: walk inside it from the feasible points known so far
         seeds = spread_seeds(self.space, self.feasible_pool(), SPREAD_SEEDS, rng)
-        for x in hit_and_run(self.constraints, rng, seeds, 20 * n):
-            if len(chosen) < n and not duplicates(self.space, x[None], np.concatenate([avoid, chosen]))[0]:
-                chosen = np.concatenate([chosen, x[None]])
-        if len(chosen) == n:
+        if add_new(hit_and_run(self.constraints, rng, seeds, 20 * n)):
             return chosen
         raise NoFeasiblePointError(
             f"could not draw {n} new feasible point(s) within {self.config.general.max_rejection_draws} uniform "

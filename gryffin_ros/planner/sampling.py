@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .constraints import KnownConstraints
+from .constraints import KnownConstraints, line_limits
 
 
 def rejection_sample(constraints: KnownConstraints, rng: np.random.Generator, m: int, max_draws: int,
@@ -96,13 +96,10 @@ def hit_and_run(constraints: KnownConstraints, rng: np.random.Generator, seeds: 
             lo = np.max(np.minimum(to_low, to_high), axis=1)
             hi = np.min(np.maximum(to_low, to_high), axis=1)
             if linear is not None:  # exact chord through the linear half-spaces: A (x + t v) <= b
-                A, b = linear
-                slope = direction @ A[:, c].T  # (chains, rows)
-                slack = b[None] - X @ A.T
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    limit = slack / slope
-                hi = np.minimum(hi, np.where(slope > 0, limit, np.inf).min(axis=1))
-                lo = np.maximum(lo, np.where(slope < 0, limit, -np.inf).max(axis=1))
+                V = np.zeros_like(X)
+                V[:, c] = direction
+                low, high = line_limits(*linear, X, V)
+                lo, hi = np.maximum(lo, low), np.minimum(hi, high)
                 hi = np.maximum(hi, lo)  # a seed on the boundary (rounding): an empty chord, the point stays
             pending = np.ones(chains, dtype=bool)
             for _ in range(shrinks):
