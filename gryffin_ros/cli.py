@@ -309,7 +309,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     exp.set_defaults(handler=export)
     ben = sub.add_parser("bench", help="run the paper's benchmark surfaces (parallel over seeds, resumable)")
     ben.add_argument("--surface", required=True, help="surface name(s), comma separated (e.g. branin,slope)")
-    ben.add_argument("--strategy", default="adam", help="adam, genetic, random, deap (comma separated)")
+    ben.add_argument("--strategy", default="adam", help="adam, genetic, gp, auto, random, deap (comma separated)")
     ben.add_argument("--seeds", type=int, default=10, help="number of runs (seeds from --first-seed)")
     ben.add_argument("--first-seed", type=int, default=0)
     ben.add_argument("--budget", type=int, default=None,

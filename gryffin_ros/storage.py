@@ -23,7 +23,7 @@ from .planner.planner import Observation, Proposal
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE IF NOT EXISTS proposals (
-    experiment_id TEXT PRIMARY KEY, params TEXT NOT NULL, strategy REAL, created REAL NOT NULL);
+    experiment_id TEXT PRIMARY KEY, params TEXT NOT NULL, strategy REAL, created REAL NOT NULL, meta TEXT);
 CREATE TABLE IF NOT EXISTS observations (
     seq INTEGER PRIMARY KEY AUTOINCREMENT, experiment_id TEXT NOT NULL UNIQUE, params TEXT NOT NULL,
     objectives TEXT NOT NULL, meta TEXT NOT NULL, raw TEXT, received REAL NOT NULL);
@@ -44,6 +44,9 @@ class CampaignStore:
                 self._db.execute("PRAGMA journal_mode=WAL")
             self._db.execute("PRAGMA synchronous=FULL")
             self._db.executescript(SCHEMA)
+            columns = {row[1] for row in self._db.execute("PRAGMA table_info(proposals)")}
+            if "meta" not in columns:  # a store written before proposals recorded how they were chosen
+                self._db.execute("ALTER TABLE proposals ADD COLUMN meta TEXT")
         except sqlite3.DatabaseError as exc:
             raise StoreError(f"cannot open campaign store '{self.path}': {exc}") from None
         stored = self.get_meta("config_hash")
@@ -108,8 +111,8 @@ class CampaignStore:
         now = time.time()
         with self._transaction():
             self._db.executemany(
-                "INSERT INTO proposals (experiment_id, params, strategy, created) VALUES (?, ?, ?, ?)",
-                [(p.experiment_id, json.dumps(p.params), p.strategy, now) for p in proposals])
+                "INSERT INTO proposals (experiment_id, params, strategy, created, meta) VALUES (?, ?, ?, ?, ?)",
+                [(p.experiment_id, json.dumps(p.params), p.strategy, now, json.dumps(p.meta)) for p in proposals])
             for key, value in (meta or {}).items():
                 self._set_meta(key, value)
 
@@ -126,8 +129,9 @@ class CampaignStore:
             raise StoreError(f"experiment_id '{observation.experiment_id}' was already reported") from None
 
     def proposals(self) -> list[Proposal]:
-        rows = self._query("SELECT experiment_id, params, strategy FROM proposals ORDER BY created, rowid")
-        return [Proposal(eid, json.loads(params), strategy) for eid, params, strategy in rows]
+        rows = self._query("SELECT experiment_id, params, strategy, meta FROM proposals ORDER BY created, rowid")
+        return [Proposal(eid, json.loads(params), strategy, json.loads(meta) if meta else {})
+                for eid, params, strategy, meta in rows]
 
     def observations(self, skip: int = 0) -> list[Observation]:
         """The stored observations in arrival order, after the first `skip` of them."""

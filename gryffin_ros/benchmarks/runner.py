@@ -27,7 +27,8 @@ from ..planner import Genetic, GryffinRosError, Planner, Random
 from ..planner.planner import BasePlanner
 from .surfaces import SURFACES, ContinuousSurface, DiscreteSurface
 
-STRATEGIES = ("adam", "genetic", "random", "deap")
+# adam/genetic: the kernel density under either acquisition optimizer; gp/auto: general.surrogate gp/auto with Adam
+STRATEGIES = ("adam", "genetic", "gp", "auto", "random", "deap")
 TRACE_POINTS = (10, 20, 50, 100)
 
 
@@ -55,6 +56,9 @@ def make_planner(surface: DiscreteSurface | ContinuousSurface, strategy: str, se
     config = surface.config(variant) if variant else surface.config()
     if strategy in ("adam", "genetic"):
         config["general"] = {"acquisition_optimizer": strategy}
+        return Planner(config, known_constraints=surface.constraint, seed=seed)
+    if strategy in ("gp", "auto"):
+        config["general"] = {"surrogate": strategy}
         return Planner(config, known_constraints=surface.constraint, seed=seed)
     cls = Random if strategy == "random" else Genetic
     return cls(config, known_constraints=surface.constraint, seed=seed)

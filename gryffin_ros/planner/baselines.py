@@ -24,9 +24,9 @@ from .selection import duplicates
 class Random(BasePlanner):
     """Uniform feasible proposals, never repeating a point of a finite space."""
 
-    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None]]:
+    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict]:
         avoid = np.concatenate([self.observed_points(), self.pending_points()])
-        return self.random_points(n, rng, avoid), [None] * n
+        return self.random_points(n, rng, avoid), [None] * n, {}
 
 
 class Genetic(BasePlanner):
@@ -35,11 +35,11 @@ class Genetic(BasePlanner):
 
     population_size = 20
 
-    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None]]:
+    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict]:
         chosen = np.concatenate([self.observed_points(), self.pending_points()])
         successful = [o for o in self.observations if not o.failed]
         if len(self.observations) + len(self.pending) < self.population_size or len(successful) < 2:
-            return self.random_points(n, rng, chosen), [None] * n
+            return self.random_points(n, rng, chosen), [None] * n, {}
         merits = self.merits(successful)
         order = np.argsort(merits)[:self.population_size]
         population = to_individuals(self._internal([successful[i].params for i in order]), merits[order])
@@ -49,7 +49,7 @@ class Genetic(BasePlanner):
                 x = self._child(population, chosen, rng)
                 chosen = np.concatenate([chosen, x[None]])
                 points.append(x)
-        return np.array(points), [None] * n
+        return np.array(points), [None] * n, {}
 
     def _child(self, population: list, chosen: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         space = self.space

@@ -51,6 +51,7 @@ class GeneralSettings:
     auto_desc_gen: bool = False
     kernel_width: str = "auto"
     concrete_temperature: float = 0.0
+    surrogate: str = "kde"
 
 
 _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
@@ -58,10 +59,11 @@ _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
     "acquisition_optimizer": (str,), "obj_transform": (str,), "feasible_fraction": (int, float),
     "random_seed": (int,), "max_rejection_draws": (int,), "softness": (int, float),
     "feas_approach": (str,), "feas_param": (int, float), "auto_desc_gen": (bool,),
-    "kernel_width": (str,), "concrete_temperature": (int, float),
+    "kernel_width": (str,), "concrete_temperature": (int, float), "surrogate": (str,),
 }
 _GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"}, "obj_transform": {"sqrt", "identity"},
-                    "feas_approach": {"fwa", "fia", "fca"}, "kernel_width": {"auto", "spacing", "gryffin"}}
+                    "feas_approach": {"fwa", "fia", "fca"}, "kernel_width": {"auto", "spacing", "gryffin"},
+                    "surrogate": {"kde", "gp", "auto"}}
 
 
 @dataclass

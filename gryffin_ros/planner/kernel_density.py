@@ -89,7 +89,9 @@ class KernelDensity:
         descriptors: learned descriptor tables replacing the space's for some finite dims (dynamic descriptors).
         temperature_scale: c in the concrete temperature 0.5 + c / rho (Gryffin: 10; the planner's default 0)."""
         self.space = space
-        locations, values = mirror(space, X, merits)
+        self.observed = np.asarray(X, dtype=float)
+        locations, self.origin = mirror(space, X, np.arange(len(X)))  # origin: the observation each kernel mirrors
+        values = np.asarray(merits, dtype=float)[self.origin]
         self.n_kernels = len(locations)
         self.rho = self.n_kernels / feasible_fraction
         self.merits = torch.as_tensor(values, dtype=DTYPE)
@@ -132,3 +134,14 @@ class KernelDensity:
         """Kernel regression of the merits: sum f_k p_k / sum p_k, (M,)."""
         weights = torch.softmax(self.log_kernels(xc, xf), dim=1)
         return weights @ self.merits
+
+    def leave_one_out(self) -> np.ndarray:
+        """(n,) kernel regression at each observation from the kernels of all other observations (its mirrored
+        copies left out too)."""
+        X, n = self.observed, len(self.observed)
+        xc = torch.as_tensor(X[:, self.space.cont_idx], dtype=DTYPE)
+        xf = torch.as_tensor(np.rint(X[:, self.space.finite_idx]), dtype=torch.long)
+        with torch.no_grad():
+            log_p = self.log_kernels(xc, xf)
+            log_p[torch.as_tensor(self.origin)[None, :] == torch.arange(n)[:, None]] = -math.inf
+            return (torch.softmax(log_p, dim=1) @ self.merits).numpy()

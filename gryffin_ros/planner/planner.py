@@ -13,7 +13,7 @@ import uuid
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import torch
@@ -32,6 +32,9 @@ from .kernel_density import KernelDensity
 from .sampling import hit_and_run, perturb, rejection_sample, spread_seeds
 from .selection import duplicates, select
 
+if TYPE_CHECKING:  # the GP module (and BoTorch, ~0.4 s to import) is loaded only by planners that use it
+    from .gaussian_process import GaussianProcess, GPAcquisition
+
 STATE_FORMAT = 1
 # Finite spaces with at most this many feasible points are searched exhaustively instead of from random starts.
 EXHAUSTIVE_LIMIT = 20_000
@@ -45,6 +48,8 @@ AUTO_SPACING_MAX_DIMS = 4
 # Start points: hit-and-run chains from up to SPREAD_SEEDS known feasible points chosen far apart, at least
 # WALK_POINTS_PER_SEED points each; V_C from at most MAX_VC_SAMPLES uniform draws.
 SPREAD_SEEDS = 16
+# general.surrogate = auto compares the GP with the kernel density once this many experiments have succeeded.
+AUTO_MIN_OBSERVATIONS = 5
 WALK_POINTS_PER_SEED = 8
 MAX_VC_SAMPLES = 2_000_000
 ConstraintArg = Callable[[dict], bool] | Sequence[Callable[[dict], bool]] | None
@@ -77,9 +82,13 @@ class Proposal:
     experiment_id: str
     params: dict[str, Any]
     strategy: float | None = None
+    meta: dict[str, Any] = field(default_factory=dict)  # how it was chosen, e.g. {"surrogate": "gp"}
 
     def to_dict(self) -> dict[str, Any]:
-        return {"experiment_id": self.experiment_id, "params": dict(self.params), "strategy": self.strategy}
+        out = {"experiment_id": self.experiment_id, "params": dict(self.params), "strategy": self.strategy}
+        if self.meta:
+            out["meta"] = dict(self.meta)
+        return out
 
 
 def _objective_value(name: str, value: Any) -> float | None:
@@ -274,9 +283,9 @@ class BasePlanner:
     def pending_points(self) -> np.ndarray:
         return self._internal([p.params for p in self.pending.values()])
 
-    def merits(self, observations: Sequence[Observation]) -> np.ndarray:
+    def merits(self, observations: Sequence[Observation], transform: bool = True) -> np.ndarray:
         """Successful observations -> minimization merits in [0, 1]: one objective rescaled (max goals negated),
-        several scalarized by Chimera; then the objective transform (sqrt by default)."""
+        several scalarized by Chimera; then (transform) the objective transform (sqrt by default)."""
         if not observations:
             return np.empty(0)
         Y = np.array([[o.objectives[obj.name] for obj in self.objectives] for o in observations], dtype=float)
@@ -286,7 +295,7 @@ class BasePlanner:
             y = -Y[:, 0] if self.objectives[0].goal == "max" else Y[:, 0]
             span = y.max() - y.min()
             f = (y - y.min()) / span if span > 0 else np.zeros_like(y)
-        return np.sqrt(f) if self.config.general.obj_transform == "sqrt" else f
+        return np.sqrt(f) if transform and self.config.general.obj_transform == "sqrt" else f
 
     def best(self) -> Observation | None:
         """The best successful observation so far (None before the first one)."""
@@ -303,11 +312,11 @@ class BasePlanner:
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise ValueError(f"n must be a positive integer, got {n!r}")
         rng = self._rng()
-        points, strategies = self._propose(n, rng)
+        points, strategies, meta = self._propose(n, rng)
         self._ask_count += 1
         proposals = []
         for strategy, params in zip(strategies, self.space.to_params(points)):
-            proposal = Proposal(str(uuid.uuid4()), self._complete(params), strategy)
+            proposal = Proposal(str(uuid.uuid4()), self._complete(params), strategy, dict(meta))
             self.pending[proposal.experiment_id] = proposal
             proposals.append(proposal)
         return proposals
@@ -321,7 +330,8 @@ class BasePlanner:
         general = self.config.general
         return [p.params for p in fresh.ask(general.batches * general.sampling_strategies)]
 
-    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None]]:
+    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
+        """n internal points, the sampling strategy of each and what every proposal of this ask records in meta."""
         raise NotImplementedError
 
     def random_points(self, n: int, rng: np.random.Generator, avoid: np.ndarray) -> np.ndarray:
@@ -379,7 +389,8 @@ class BasePlanner:
             raise ConfigError(f"state was saved by {state.get('strategy')!r}, not {cls.__name__}")
         planner = cls(load_config(state["config"], base_dir), known_constraints, state["seed"])
         planner.observations = [planner.parse_observation(o) for o in state["observations"]]
-        planner.pending = {p["experiment_id"]: Proposal(p["experiment_id"], p["params"], p.get("strategy"))
+        planner.pending = {p["experiment_id"]: Proposal(p["experiment_id"], p["params"], p.get("strategy"),
+                                                        dict(p.get("meta") or {}))
                            for p in state["pending"]}
         planner._ask_count = int(state["ask_count"])
         planner._proposal_count = int(state["proposal_count"])
@@ -388,7 +399,16 @@ class BasePlanner:
 
 class Planner(BasePlanner):
     """Gryffin with known constraints: kernel-density surrogate, lambda strategies, constrained Adam+Hill or genetic
-    acquisition optimization, diversity-aware selection."""
+    acquisition optimization, diversity-aware selection; or (general.surrogate) a Gaussian process under the same
+    constrained optimizers, or the better ranking of the two on the data so far."""
+
+    def __init__(self, config: Mapping | str | Path | PlannerConfig, known_constraints: ConstraintArg = None,
+                 seed: int | None = None):
+        super().__init__(config, known_constraints, seed)
+        self._gp_fit: tuple[int, dict] | None = None  # (observations fitted, GP hyperparameters) of the last fit
+        if self.config.general.surrogate != "kde":
+            from .gaussian_process import require_botorch
+            require_botorch()
 
     def strategy_values(self) -> np.ndarray:
         """Sampling strategies s, from exploitation (+1) to exploration (-1); a single strategy is s = 0."""
@@ -484,7 +504,52 @@ class Planner(BasePlanner):
             points.append(x)
         return np.array(points)
 
-    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None]]:
+    def _gaussian_process(self, X: np.ndarray, successful: Sequence[Observation],
+                          descriptors: Mapping[int, np.ndarray]) -> GaussianProcess:
+        """The GP of the untransformed merits (a square root would put a cusp at the optimum), conditioned on every
+        successful experiment, with hyperparameters fitted to the first `fit_size(n)` of them (cached; learned
+        descriptors change with every observation, so with them every ask fits). Fits are seeded by the campaign
+        seed and their size alone, so they never change the draws of the rest of the ask."""
+        from .gaussian_process import GaussianProcess, fit_size
+
+        def seed(size: int) -> int:
+            return int(np.random.default_rng([self.seed, size, 3]).integers(2**62))
+
+        size = len(X) if descriptors else fit_size(len(X))
+        hyperparameters = self._gp_fit[1] if self._gp_fit and self._gp_fit[0] == size else None
+        if hyperparameters is None and size < len(X):
+            hyperparameters = GaussianProcess(self.space, X[:size], self.merits(successful[:size], transform=False),
+                                              seed(size)).hyperparameters
+        gp = GaussianProcess(self.space, X, self.merits(successful, transform=False), seed(size), descriptors,
+                             hyperparameters)
+        if not descriptors:
+            self._gp_fit = (size, gp.hyperparameters)
+        return gp
+
+    def _choose_surrogate(self, X: np.ndarray, merits: np.ndarray, successful: Sequence[Observation],
+                          density: KernelDensity, descriptors: Mapping[int, np.ndarray]
+                          ) -> tuple[GaussianProcess | None, dict[str, Any]]:
+        """general.surrogate: the GP (or None for the kernel density) and what the proposals record about the choice.
+
+        `auto` compares the two models on the data so far by the rank correlation of their leave-one-out predictions
+        with the observed merits (what the acquisition needs is the ordering of points, not calibrated values); the
+        GP is used only when it ranks strictly better, and never before AUTO_MIN_OBSERVATIONS successes."""
+        surrogate = self.config.general.surrogate
+        if surrogate == "kde":
+            return None, {"surrogate": "kde"}
+        if surrogate == "gp":
+            return self._gaussian_process(X, successful, descriptors), {"surrogate": "gp"}
+        if len(X) < AUTO_MIN_OBSERVATIONS or np.ptp(merits) == 0:
+            return None, {"surrogate": "kde", "surrogate_reason": f"auto: fewer than {AUTO_MIN_OBSERVATIONS} "
+                          "distinct successful results"}
+        from .gaussian_process import rank_correlation
+        gp = self._gaussian_process(X, successful, descriptors)
+        scores = {"kde": round(rank_correlation(density.leave_one_out(), merits), 4),
+                  "gp": round(rank_correlation(gp.leave_one_out(), merits), 4)}
+        chosen = "gp" if scores["gp"] > scores["kde"] else "kde"
+        return (gp if chosen == "gp" else None), {"surrogate": chosen, "loo_rank_correlation": scores}
+
+    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
         observed = self.observed_points()
         chosen = self.pending_points()
         successful = [o for o in self.observations if not o.failed]
@@ -492,16 +557,18 @@ class Planner(BasePlanner):
         feasibility = self._feasibility(observed, generator)
         if not successful:
             if feasibility is None:
-                return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n
-            return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n
+                return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n, {}
+            return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n, {}
         X = self._internal([o.params for o in successful])
         merits = self.merits(successful)
         descriptors = {d: r.table for d, r in self.learned_descriptors(X, merits).items()}
         density = KernelDensity(self.space, X, merits, self.feasible_fraction.value, generator,
                                 spacing_scaled=self.spacing_kernels, spacing_factor=SPACING_FACTOR,
                                 descriptors=descriptors, temperature_scale=self.config.general.concrete_temperature)
+        gp, meta = self._choose_surrogate(X, merits, successful, density, descriptors)
         start, exhaustive = self._start_points(rng, X[int(np.argmin(merits))], X)
-        general = self.config.general
+        if gp is not None:
+            return self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen), [None] * n, meta
         values = self.strategy_values()
         optimizer = self._optimizer()
         refined: dict[float, tuple[np.ndarray, np.ndarray]] = {}
@@ -510,17 +577,8 @@ class Planner(BasePlanner):
             s = float(values[self._proposal_count % len(values)])
             self._proposal_count += 1
             if s not in refined:
-                acquisition = Acquisition(density, s)
-                if exhaustive:
-                    candidates, alpha = start, acquisition.evaluate(start)
-                else:
-                    candidates, alpha = optimizer.optimize(acquisition, start, rng)
-                    keep = self.constraints.feasible(candidates)  # guaranteed by the optimizers; never trusted blindly
-                    candidates, alpha = candidates[keep], alpha[keep]
-                if feasibility is not None:
-                    alpha = combine(alpha, feasibility.probability(candidates), general.feas_approach,
-                                    general.feas_param, feasibility.fraction_failed)
-                refined[s] = (candidates, alpha)
+                refined[s] = self._candidates(Acquisition(density, s), start, exhaustive, optimizer, rng,
+                                              feasibility)
             candidates, alpha = refined[s]
             index = select(self.space, candidates, alpha, observed, chosen) if len(candidates) else None
             x = candidates[index] if index is not None else self.random_points(
@@ -528,4 +586,39 @@ class Planner(BasePlanner):
             chosen = np.concatenate([chosen, x[None]])
             points.append(x)
             strategies.append(s)
-        return np.array(points), strategies
+        return np.array(points), strategies, meta
+
+    def _candidates(self, acquisition: Acquisition | GPAcquisition, start: np.ndarray, exhaustive: bool,
+                    optimizer: AdamHillOptimizer | GeneticOptimizer, rng: np.random.Generator,
+                    feasibility: FeasibilityModel | None) -> tuple[np.ndarray, np.ndarray]:
+        """Optimized feasible candidates and their scores (acquisition combined with P(feasible) once experiments
+        have failed); the whole feasible set, scored, when it is small enough."""
+        if exhaustive:
+            candidates, alpha = start, acquisition.evaluate(start)
+        else:
+            candidates, alpha = optimizer.optimize(acquisition, start, rng)
+            keep = self.constraints.feasible(candidates)  # guaranteed by the optimizers; never trusted blindly
+            candidates, alpha = candidates[keep], alpha[keep]
+        if feasibility is not None:
+            general = self.config.general
+            alpha = combine(alpha, feasibility.probability(candidates), general.feas_approach, general.feas_param,
+                            feasibility.fraction_failed)
+        return candidates, alpha
+
+    def _propose_gp(self, n: int, rng: np.random.Generator, gp: GaussianProcess, start: np.ndarray, exhaustive: bool,
+                    feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray) -> np.ndarray:
+        """n points by the GP's expected improvement; pending experiments and the batch's earlier proposals enter the
+        GP as believed results (kriging believer), so a batch spreads out without Gryffin's strategies."""
+        gp.believe(chosen)
+        optimizer = self._optimizer()
+        points = []
+        for i in range(n):
+            candidates, alpha = self._candidates(gp.acquisition(), start, exhaustive, optimizer, rng, feasibility)
+            index = select(self.space, candidates, alpha, observed, chosen, diverse=False) if len(candidates) else None
+            x = candidates[index] if index is not None else self.random_points(
+                1, rng, np.concatenate([observed, chosen]))[0]
+            chosen = np.concatenate([chosen, x[None]])
+            points.append(x)
+            if i + 1 < n:
+                gp.believe(x[None])
+        return np.array(points)

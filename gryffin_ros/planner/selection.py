@@ -38,15 +38,14 @@ def diversity(space: SearchSpace, candidates: np.ndarray, reference: np.ndarray,
 
 
 def select(space: SearchSpace, candidates: np.ndarray, alpha: np.ndarray, observed: np.ndarray,
-           chosen: np.ndarray) -> int | None:
-    """Index of the best candidate, or None when every candidate duplicates an observed or chosen point."""
+           chosen: np.ndarray, diverse: bool = True) -> int | None:
+    """Index of the best candidate, or None when every candidate duplicates an observed or chosen point. Without
+    `diverse` the best new candidate by alpha alone (the GP's expected improvement already weighs exploration)."""
     reference = np.concatenate([observed, chosen]) if len(chosen) else observed
-    finite = np.isfinite(alpha)  # +inf marks a candidate that must not be chosen (fca)
-    if not finite.any():
+    allowed = np.isfinite(alpha) & ~duplicates(space, candidates, reference)  # +inf: must not be chosen (fca)
+    if not allowed.any():
         return None
-    reward = np.where(finite, np.exp(-(alpha - alpha[finite].min())), 0.0)  # shifted: same argmax, no overflow
-    reward[duplicates(space, candidates, reference)] = 0.0
-    if not (reward > 0).any():
-        return None
-    score = reward * diversity(space, candidates, reference, len(observed))
-    return int(np.argmax(score))
+    if not diverse:
+        return int(np.argmin(np.where(allowed, alpha, np.inf)))
+    reward = np.where(allowed, np.exp(-(alpha - alpha[allowed].min())), 0.0)  # shifted: same argmax, no overflow
+    return int(np.argmax(reward * diversity(space, candidates, reference, len(observed))))
