@@ -1,6 +1,6 @@
 # The two commands of the README: `make demo` runs the main job, `make test` the test suite. Each first creates or
-# refreshes the local virtual environment (torch pinned through constraints.txt, then the package with its test and
-# ROS 2 extras).
+# refreshes the local virtual environment (torch pinned through constraints.txt, then the package with its test,
+# ROS 2 and GP extras).
 VENV ?= .venv
 PYTHON ?= python3
 PY := $(VENV)/bin/python
@@ -17,7 +17,7 @@ $(STAMP): setup.py constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -c constraints.txt torch==2.13.0
-	$(PY) -m pip install --quiet -c constraints.txt -e '.[test,ros]'
+	$(PY) -m pip install --quiet -c constraints.txt -e '.[test,ros,gp]'
 	touch $(STAMP)
 
 venv: $(STAMP)

@@ -34,6 +34,8 @@ setup(
     extras_require={
         "test": ["pytest>=8", "hypothesis>=6", "ruff>=0.5"],
         "ros": ["ros-jazzy-rclpy", "ros-jazzy-common-interfaces", "ros-jazzy-rmw-fastrtps-cpp"],
+        # general.surrogate gp/auto: BoTorch (GPyTorch, SciPy) on the torch above
+        "gp": ["botorch>=0.12"],
     },
     entry_points={
         "console_scripts": [

@@ -42,6 +42,7 @@ try:
     from gpytorch.constraints import GreaterThan, Interval
     from gpytorch.kernels import MaternKernel, ScaleKernel
     from gpytorch.mlls import ExactMarginalLogLikelihood
+    from gpytorch.utils.warnings import NumericalWarning
 except ImportError as _error:  # the GP is an extra: `pip install gryffin_ros[gp]`
     _IMPORT_ERROR: ImportError | None = _error
 else:
@@ -201,7 +202,10 @@ class GPAcquisition:
         self.log_ei = LogExpectedImprovement(gp.model, best_f=gp.best, maximize=False)
 
     def _alpha(self, xc: torch.Tensor, xf: torch.Tensor) -> torch.Tensor:
-        return -self.log_ei(self.features(xc, xf)[:, None, :])
+        with warnings.catch_warnings():
+            # GPyTorch rounds variances that come out slightly negative (at observed points) up to 1e-10 and says so
+            warnings.simplefilter("ignore", NumericalWarning)
+            return -self.log_ei(self.features(xc, xf)[:, None, :])
 
     def evaluate(self, X: np.ndarray) -> np.ndarray:
         """alpha at (M, D) internal points."""
