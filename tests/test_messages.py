@@ -38,3 +38,12 @@ def test_oversized_message_is_refused_before_parsing():
 def test_outgoing_payloads_are_checked_too():
     with pytest.raises(messages.MessageError):
         messages.dump("event", {"type": "something_else"})
+
+
+def test_proposals_carry_how_they_were_chosen():
+    from gryffin_ros.planner import Proposal
+    proposal = Proposal("e1", {"x": 0.5}, None, {"surrogate": "gp", "loo_rank_correlation": {"kde": 0.1, "gp": 0.8}})
+    document = json.loads(messages.proposals_message("c", [proposal], 7))
+    assert document["proposals"][0]["meta"]["surrogate"] == "gp"
+    with pytest.raises(messages.MessageError):  # meta must be an object
+        messages.dump("proposals", {**document, "proposals": [{**document["proposals"][0], "meta": "gp"}]})

@@ -60,3 +60,23 @@ def test_open_existing_refuses_other_files(tmp_path):
         CampaignStore.open_existing(tmp_path / "x.sqlite")
     with pytest.raises(StoreError, match="no campaign store"):
         CampaignStore.open_existing(tmp_path / "missing.sqlite")
+
+
+def test_proposal_meta_is_stored_and_old_stores_gain_the_column(tmp_path):
+    import sqlite3
+    path = tmp_path / "old.sqlite"
+    with sqlite3.connect(path) as db:  # a store written before proposals had meta
+        db.executescript(
+            "CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);"
+            "CREATE TABLE proposals (experiment_id TEXT PRIMARY KEY, params TEXT NOT NULL, strategy REAL,"
+            " created REAL NOT NULL);"
+            "INSERT INTO meta VALUES ('config', '{}'), ('config_hash', 'h1');"
+            "INSERT INTO proposals VALUES ('old', '{\"x\": 0.5}', 1.0, 0.0);")
+    store = CampaignStore(path, CONFIG, "h1")
+    store.add_proposals([Proposal("new", {"x": 0.1}, None, {"surrogate": "gp",
+                                                           "loo_rank_correlation": {"kde": 0.2, "gp": 0.9}})])
+    reopened = CampaignStore(path, CONFIG, "h1")
+    old, new = reopened.proposals()
+    assert (old.experiment_id, old.meta, old.strategy) == ("old", {}, 1.0)
+    assert new.meta == {"surrogate": "gp", "loo_rank_correlation": {"kde": 0.2, "gp": 0.9}}
+    assert new.to_dict()["meta"]["surrogate"] == "gp" and "meta" not in old.to_dict()
