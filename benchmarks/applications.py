@@ -6,6 +6,7 @@
   (R1_0, R3_7, R4_7, R5_0) is measured, with dynamic descriptors, static descriptors and none.
 
     python benchmarks/applications.py [--seeds 20] [--processes 2] [--data ../shared/data] [--out benchmarks/results]
+                                      [--flow adam,gp,auto]   (flow-reactor surrogates: kde with Adam, gp, auto)
 
 Per-run results go to <out>/applications_runs.json (resumable); the table to applications.md, plots to
 applications_flow.png and applications_redox.png.
@@ -29,6 +30,7 @@ from gryffin_ros.paths import share_path
 BUDGET = 100
 BEST_REDOX = ("R1_0", "R3_7", "R4_7", "R5_0")
 REDOX_VARIANTS = ("dynamic", "static", "no")
+FLOW_VARIANTS = {"adam": "gryffin_ros (Adam)", "gp": "gryffin_ros (GP)", "auto": "gryffin_ros (auto)"}
 
 
 def redox_config(variant: str) -> dict:
@@ -46,12 +48,15 @@ def run(job: tuple[str, str, int]) -> dict:
 
     from gryffin_ros.emulators import FlowReactorEmulator, RedoxEmulator
     from gryffin_ros.planner import Planner
-    from gryffin_ros.planner.config import load_config
+    from gryffin_ros.planner.config import load_config, read_config
     torch.set_num_threads(1)
     app, variant, seed = job
     examples = share_path("examples")
     if app == "flow":
-        planner, emulator = Planner(str(examples / "flow_reactor.yaml"), seed=seed), FlowReactorEmulator(seed=seed)
+        config = read_config(examples / "flow_reactor.yaml")
+        if variant != "adam":
+            config.setdefault("general", {})["surrogate"] = variant
+        planner, emulator = Planner(load_config(config, examples), seed=seed), FlowReactorEmulator(seed=seed)
     else:
         planner, emulator = Planner(load_config(redox_config(variant), examples), seed=seed), RedoxEmulator()
     names = [o.name for o in planner.objectives]
@@ -120,11 +125,15 @@ def main() -> None:
     parser.add_argument("--processes", type=int, default=2)
     parser.add_argument("--data", type=Path, default=Path(__file__).resolve().parents[2] / "shared" / "data")
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
+    parser.add_argument("--flow", default="adam", help="flow-reactor surrogates, comma separated: adam (kde), gp, auto")
     args = parser.parse_args()
+    flow_variants = [v for v in args.flow.split(",") if v]
+    if set(flow_variants) - set(FLOW_VARIANTS):
+        parser.error(f"--flow: choose from {', '.join(FLOW_VARIANTS)}")
     args.out.mkdir(parents=True, exist_ok=True)
     store = args.out / "applications_runs.json"
     done = {(r["app"], r["variant"], r["seed"]): r for r in (json.loads(store.read_text()) if store.exists() else [])}
-    jobs = [("flow", "adam", s) for s in range(args.seeds)]
+    jobs = [("flow", v, s) for v in flow_variants for s in range(args.seeds)]
     jobs += [("redox", v, s) for v in REDOX_VARIANTS for s in range(args.seeds)]
     with Pool(args.processes) as pool:
         for result in pool.imap_unordered(run, [j for j in jobs if j not in done]):
@@ -132,12 +141,13 @@ def main() -> None:
             store.write_text(json.dumps(list(done.values())))
     ours = [r for key, r in done.items() if key in set(jobs)]
 
-    flow = [np.array([[t["X1_X2"], t["cost"]] for t in r["trace"]]) for r in ours if r["app"] == "flow"]
+    flows = {FLOW_VARIANTS[v]: [np.array([[t["X1_X2"], t["cost"]] for t in r["trace"]]) for r in ours
+                                if r["app"] == "flow" and r["variant"] == v] for v in flow_variants}
     paper = paper_flow(args.data)
     lines = [f"Flow reactor, {BUDGET} experiments: cost ($/min) of the best experiment by the Chimera hierarchy at "
              "iteration 100 (mean ± s.e.), and runs whose best reached X1 + X2 >= 0.9.", "",
              "| strategy | runs | cost at 100 | X1 + X2 >= 0.9 |", "|---|---|---|---|"]
-    for name, traces in [("gryffin_ros (Adam)", flow)] + [(f"paper: {k}", v) for k, v in sorted(paper.items())]:
+    for name, traces in list(flows.items()) + [(f"paper: {k}", v) for k, v in sorted(paper.items())]:
         final = np.array([t[-1] for t in traces])
         se = final[:, 1].std(ddof=1) / np.sqrt(len(final)) if len(final) > 1 else float("nan")
         lines.append(f"| {name} | {len(final)} | {final[:, 1].mean():.4f} ± {se:.4f} | "
@@ -154,15 +164,16 @@ def main() -> None:
     text = "\n".join(lines) + "\n"
     (args.out / "applications.md").write_text(text)
     print(text)
-    plot(flow, paper, ours, paper_redox(args.data), args.out)
+    plot(flows, paper, ours, paper_redox(args.data), args.out)
 
 
-def plot(flow, paper, ours, paper_found, out: Path) -> None:
+def plot(flows, paper, ours, paper_found, out: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6, 4))
-    for name, traces, style in [("gryffin_ros", flow, "-")] + [(f"paper {k}", v, "--") for k, v in paper.items()]:
+    for name, traces, style in ([(k, v, "-") for k, v in flows.items()]
+                                + [(f"paper {k}", v, "--") for k, v in paper.items()]):
         length = min(len(t) for t in traces)
         ax.plot(range(1, length + 1), np.mean([t[:length, 1] for t in traces], axis=0), style, label=name)
     ax.set(xlabel="experiment", ylabel="cost of best ($/min)", yscale="log", title="Flow reactor (mean best-so-far)")

@@ -35,7 +35,8 @@ PUBLISHED = {"random": "Random", "deap": "Genetic (DEAP)", "opt_adam": "Gryffin 
              "opt_genetic": "Gryffin (Genetic)", "dragonfly": "Dragonfly"}
 SUMMARY_COLUMNS = {"random": "Random", "deap": "Genetic (DEAP)", "gryffin_adam": "Gryffin (Adam)",
                    "gryffin_genetic": "Gryffin (Genetic)", "dragonfly": "Dragonfly"}
-OURS = {"adam": "ours: Adam/Hill", "genetic": "ours: Genetic", "random": "ours: Random", "deap": "ours: DEAP"}
+OURS = {"adam": "ours: Adam/Hill", "genetic": "ours: Genetic", "gp": "ours: GP", "auto": "ours: auto (GP|KDE)",
+        "random": "ours: Random", "deap": "ours: DEAP"}
 DISCRETE_FOLDER = {"slope": "cat-slope", "sphere": "cat-dejong", "michalewicz": "cat-michalewicz",
                    "camel": "cat-camel"}
 TARGETS = {"slope": 10, "sphere": 12.5, "michalewicz": 16.5, "camel": 30,

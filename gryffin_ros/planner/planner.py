@@ -532,8 +532,10 @@ class Planner(BasePlanner):
         """general.surrogate: the GP (or None for the kernel density) and what the proposals record about the choice.
 
         `auto` compares the two models on the data so far by the rank correlation of their leave-one-out predictions
-        with the observed merits (what the acquisition needs is the ordering of points, not calibrated values); the
-        GP is used only when it ranks strictly better, and never before AUTO_MIN_OBSERVATIONS successes."""
+        with the observed merits (what the acquisition needs is the ordering of points, not calibrated values). The
+        GP, which departs from the paper, is used only when it ranks better by more than the sampling error of the
+        score (Fisher z of Spearman's r, s.e. sqrt(1.06 / (n - 3))), and never before AUTO_MIN_OBSERVATIONS
+        successes."""
         surrogate = self.config.general.surrogate
         if surrogate == "kde":
             return None, {"surrogate": "kde"}
@@ -546,7 +548,8 @@ class Planner(BasePlanner):
         gp = self._gaussian_process(X, successful, descriptors)
         scores = {"kde": round(rank_correlation(density.leave_one_out(), merits), 4),
                   "gp": round(rank_correlation(gp.leave_one_out(), merits), 4)}
-        chosen = "gp" if scores["gp"] > scores["kde"] else "kde"
+        z = {name: math.atanh(min(max(r, -0.999), 0.999)) for name, r in scores.items()}
+        chosen = "gp" if z["gp"] - z["kde"] > math.sqrt(1.06 / (len(X) - 3)) else "kde"
         return (gp if chosen == "gp" else None), {"surrogate": chosen, "loo_rank_correlation": scores}
 
     def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
