@@ -168,3 +168,21 @@ def test_mixture_campaign_over_ros_proposes_exact_blends_and_names_a_broken_one(
     assert events[1]["type"] == "observation_rejected" and "water + ethanol + dmso == 1.0" in events[1]["reason"]
     assert events[2]["type"] == "observation_rejected" and "missing parameter(s) ['dmso']" in events[2]["reason"]
     assert stored_ids(tmp_path / "campaign.sqlite") == [first["experiment_id"]]
+
+
+def test_gp_campaign_over_ros_records_the_surrogate_in_messages_and_store(client, start_planner, tmp_path):
+    start_planner({**FLOW_CONFIG, "general": {"surrogate": "gp"}}, auto_propose=False)
+    client.wait_matched()
+    start = len(client.wait_events(0))
+    for i in range(3):
+        document = json.loads(client.recommend().message)
+        messages.check("proposals", document)
+        (proposal,) = document["proposals"]
+        assert flow_feasible(proposal["params"])
+        assert proposal.get("meta", {}).get("surrogate") == ("gp" if i else None)  # the first one is a random pick
+        client.publish(observation(proposal, value=0.2 + 0.1 * i))
+        client.wait_events(start + i + 1)
+    with sqlite3.connect(tmp_path / "campaign.sqlite") as db:
+        stored = [json.loads(meta or "{}").get("surrogate") for (meta,) in
+                  db.execute("SELECT meta FROM proposals ORDER BY created, rowid")]
+    assert stored == [None, "gp", "gp"]
