@@ -48,7 +48,8 @@ AUTO_SPACING_MAX_DIMS = 4
 # Start points: hit-and-run chains from up to SPREAD_SEEDS known feasible points chosen far apart, at least
 # WALK_POINTS_PER_SEED points each; V_C from at most MAX_VC_SAMPLES uniform draws.
 SPREAD_SEEDS = 16
-# general.surrogate = auto compares the GP with the kernel density once this many experiments have succeeded.
+# general.surrogate = auto compares the GP with the kernel density once the successful experiments have this many
+# distinct results.
 AUTO_MIN_OBSERVATIONS = 5
 WALK_POINTS_PER_SEED = 8
 MAX_VC_SAMPLES = 2_000_000
@@ -534,14 +535,16 @@ class Planner(BasePlanner):
         `auto` compares the two models on the data so far by the rank correlation of their leave-one-out predictions
         with the observed merits (what the acquisition needs is the ordering of points, not calibrated values). The
         GP, which departs from the paper, is used only when it ranks better by more than the sampling error of the
-        score (Fisher z of Spearman's r, s.e. sqrt(1.06 / (n - 3))), and never before AUTO_MIN_OBSERVATIONS
-        successes."""
+        score (Fisher z of Spearman's r, s.e. sqrt(1.06 / (m - 3))), m the number of distinct merits: tied results
+        carry no ranking, so on plateaus (a step-shaped surface with a few levels) the score says little and the
+        kernel density stays; never with fewer than AUTO_MIN_OBSERVATIONS distinct merits."""
         surrogate = self.config.general.surrogate
         if surrogate == "kde":
             return None, {"surrogate": "kde"}
         if surrogate == "gp":
             return self._gaussian_process(X, successful, descriptors), {"surrogate": "gp"}
-        if len(X) < AUTO_MIN_OBSERVATIONS or np.ptp(merits) == 0:
+        levels = len(np.unique(merits))
+        if levels < AUTO_MIN_OBSERVATIONS:
             return None, {"surrogate": "kde", "surrogate_reason": f"auto: fewer than {AUTO_MIN_OBSERVATIONS} "
                           "distinct successful results"}
         from .gaussian_process import rank_correlation
@@ -549,7 +552,7 @@ class Planner(BasePlanner):
         scores = {"kde": round(rank_correlation(density.leave_one_out(), merits), 4),
                   "gp": round(rank_correlation(gp.leave_one_out(), merits), 4)}
         z = {name: math.atanh(min(max(r, -0.999), 0.999)) for name, r in scores.items()}
-        chosen = "gp" if z["gp"] - z["kde"] > math.sqrt(1.06 / (len(X) - 3)) else "kde"
+        chosen = "gp" if z["gp"] - z["kde"] > math.sqrt(1.06 / (levels - 3)) else "kde"
         return (gp if chosen == "gp" else None), {"surrogate": chosen, "loo_rank_correlation": scores}
 
     def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:

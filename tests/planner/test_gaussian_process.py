@@ -150,9 +150,17 @@ def test_auto_compares_the_models_and_records_its_choice():
     meta = run(planner, 12, bowl)[-1].meta
     scores = meta["loo_rank_correlation"]
     z_gp, z_kde = np.arctanh(min(scores["gp"], 0.999)), np.arctanh(min(scores["kde"], 0.999))
-    assert meta["surrogate"] == ("gp" if z_gp - z_kde > np.sqrt(1.06 / (16 - 3)) else "kde")
+    assert meta["surrogate"] == ("gp" if z_gp - z_kde > np.sqrt(1.06 / (16 - 3)) else "kde")  # 16 distinct results
     assert meta["surrogate"] == "gp"  # on a smooth bowl the GP ranks the left-out points better
     assert scores["gp"] > 0.9
+
+
+def test_auto_keeps_the_kernel_density_on_plateaus():
+    """A step-shaped objective with 3 levels: ties rank nothing, so the score cannot favour the GP."""
+    planner = Planner(config("auto"), seed=0)
+    made = run(planner, 20, lambda p: float(min(2, int(3 * bowl(p)))))
+    assert {p.meta["surrogate"] for p in made[1:]} == {"kde"}
+    assert all("fewer than 5 distinct" in p.meta["surrogate_reason"] for p in made[1:])
 
 
 def test_gp_proposals_survive_a_restart_exactly():
