@@ -11,7 +11,7 @@ from gryffin_ros.planner import gaussian_process as gp_module
 from gryffin_ros.planner.gaussian_process import Features, GaussianProcess, fit_size, rank_correlation
 from gryffin_ros.planner.space import SearchSpace
 from tests.conftest import branin, branin_feasible
-from tests.planner.test_properties import assert_clear_refusal, assert_valid, problems
+from tests.planner.test_properties import exercise, problems
 
 
 def bowl(p):
@@ -190,18 +190,8 @@ def test_unknown_surrogate_is_refused():
 @given(problem=problems(), surrogate=st.sampled_from(["gp", "auto"]), optimizer=st.sampled_from(["adam", "genetic"]),
        seed=st.integers(0, 2**31))
 def test_gp_proposals_are_always_feasible_in_bounds_and_typed(problem, surrogate, optimizer, seed):
-    specs, texts, checks, objective = problem
+    specs, texts, _, _ = problem
     planner = Planner({"parameters": specs, "objectives": [{"name": "y", "goal": "min"}], "constraints": texts,
                        "general": {"surrogate": surrogate, "acquisition_optimizer": optimizer,
                                    "num_random_samples": 15}}, seed=seed)
-    rng = np.random.default_rng(seed)
-    for _ in range(7):
-        try:
-            proposals = planner.ask(2)
-        except Exception as exc:
-            assert_clear_refusal(exc, specs, checks)
-            return
-        for proposal in proposals:
-            assert_valid(specs, checks, proposal.params)
-            y = None if rng.random() < 0.1 else objective(proposal.params)
-            planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
+    exercise(planner, problem, rounds=7, seed=seed)
