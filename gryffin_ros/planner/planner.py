@@ -48,11 +48,11 @@ AUTO_SPACING_MAX_DIMS = 4
 # Start points: hit-and-run chains from up to SPREAD_SEEDS known feasible points chosen far apart, at least
 # WALK_POINTS_PER_SEED points each; V_C from at most MAX_VC_SAMPLES uniform draws.
 SPREAD_SEEDS = 16
+WALK_POINTS_PER_SEED = 8
+MAX_VC_SAMPLES = 2_000_000
 # general.surrogate = auto compares the GP with the kernel density once the successful experiments have this many
 # distinct results.
 AUTO_MIN_OBSERVATIONS = 5
-WALK_POINTS_PER_SEED = 8
-MAX_VC_SAMPLES = 2_000_000
 ConstraintArg = Callable[[dict], bool] | Sequence[Callable[[dict], bool]] | None
 
 
