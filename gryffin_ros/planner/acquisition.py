@@ -15,10 +15,17 @@ import numpy as np
 import torch
 
 from .kernel_density import DTYPE, KernelDensity
+from .space import SearchSpace
 
 CUTOFF = 50.0
 # Largest number of (candidate, kernel) pairs in one dense pass; bounds memory for large n and many candidates.
 CHUNK_ELEMENTS = 2_000_000
+
+
+def split(space: SearchSpace, X: np.ndarray) -> tuple[torch.Tensor, torch.Tensor]:
+    """(M, D) internal points -> continuous coordinates (M, C) float and option indices (M, F) long."""
+    return (torch.as_tensor(X[:, space.cont_idx], dtype=DTYPE),
+            torch.as_tensor(np.rint(X[:, space.finite_idx]), dtype=torch.long))
 
 
 class Acquisition:
@@ -26,10 +33,6 @@ class Acquisition:
         self.density = density
         self.strategy = float(strategy)
 
-    def _split(self, X: np.ndarray) -> tuple[torch.Tensor, torch.Tensor]:
-        space = self.density.space
-        return (torch.as_tensor(X[:, space.cont_idx], dtype=DTYPE),
-                torch.as_tensor(np.rint(X[:, space.finite_idx]), dtype=torch.long))
 
     def _alpha(self, log_p: torch.Tensor, shift: torch.Tensor) -> torch.Tensor:
         # terms below e^-(2 CUTOFF) of the largest are set to exactly 0: they are far below float64 resolution of the
@@ -60,7 +63,7 @@ class Acquisition:
         return alpha, grad
 
     def _run(self, X: np.ndarray, with_grad: bool) -> tuple[np.ndarray, np.ndarray]:
-        xc, xf = self._split(X)
+        xc, xf = split(self.density.space, X)
         alpha, grad = np.empty(len(X)), np.zeros((len(X), xc.shape[1]))
         step = max(1, CHUNK_ELEMENTS // max(1, self.density.n_kernels))
         for start in range(0, len(X), step):

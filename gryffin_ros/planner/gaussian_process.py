@@ -17,6 +17,7 @@ from functools import partial
 import numpy as np
 import torch
 
+from .acquisition import split
 from .errors import ConfigError
 from .space import SearchSpace
 
@@ -101,12 +102,6 @@ class Features:
     def of(self, X: np.ndarray) -> torch.Tensor:
         """(M, D) internal points -> (M, G) inputs."""
         return self(*split(self.space, X))
-
-
-def split(space: SearchSpace, X: np.ndarray) -> tuple[torch.Tensor, torch.Tensor]:
-    """(M, D) internal points -> continuous coordinates (M, C) float and option indices (M, F) long."""
-    return (torch.as_tensor(X[:, space.cont_idx], dtype=DTYPE),
-            torch.as_tensor(np.rint(X[:, space.finite_idx]), dtype=torch.long))
 
 
 def fit_size(n: int) -> int:
