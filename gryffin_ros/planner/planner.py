@@ -23,7 +23,7 @@ from .adam_hill import AdamHillOptimizer
 from .chimera import Chimera
 from .config import PlannerConfig, load_config
 from .constraints import FeasibleFraction, KnownConstraints, estimate_feasible_fraction
-from .descriptors import LearnedDescriptors, learn_descriptors
+from .descriptors import LearnedDescriptors, learn_many
 from .equalities import LinearEqualities
 from .errors import ConfigError, ExhaustedSpaceError, NoFeasiblePointError, ObservationError
 from .feasibility import FeasibilityModel, combine
@@ -452,14 +452,10 @@ class Planner(BasePlanner):
         """Dynamic descriptors for each categorical dim with several descriptors (general.auto_desc_gen)."""
         if not self.config.general.auto_desc_gen:
             return {}
-        learned = {}
-        for d in self.space.finite_idx:
-            table = self.space.descriptors(d)
-            if self.space.parameters[d].kind == "categorical" and table is not None and table.shape[1] > 1:
-                result = learn_descriptors(table, X[:, d].astype(int), target)
-                if result is not None:
-                    learned[int(d)] = result
-        return learned
+        dims = [int(d) for d in self.space.finite_idx if self.space.parameters[d].kind == "categorical"
+                and self.space.descriptors(d) is not None and self.space.descriptors(d).shape[1] > 1]
+        results = learn_many([(self.space.descriptors(d), X[:, d].astype(int)) for d in dims], target)
+        return {d: result for d, result in zip(dims, results) if result is not None}
 
     def descriptor_summary(self) -> dict[str, dict[str, Any]]:
         """What dynamic descriptors learned from the current data, per categorical parameter: for the objective

@@ -3,7 +3,7 @@
 import numpy as np
 
 from gryffin_ros.planner import Planner
-from gryffin_ros.planner.descriptors import learn_descriptors
+from gryffin_ros.planner.descriptors import learn_descriptors, learn_many
 
 OPTIONS = [f"m{i}" for i in range(10)]
 RNG = np.random.default_rng(0)
@@ -32,6 +32,31 @@ def test_too_little_or_constant_data_learns_nothing():
     table = np.array([DESCRIPTORS[o] for o in OPTIONS]) / 10.0
     assert learn_descriptors(table, np.array([0, 1, 2]), np.array([1.0, 2.0, 3.0])) is None
     assert learn_descriptors(table, np.array([0, 1, 2, 3, 4]), np.ones(5)) is None
+
+
+def test_descriptor_constant_over_the_observed_options_is_left_out_not_fatal():
+    # column 1 is the same for every observed option (its correlation would be 0/0); the others still learn
+    table = np.array([[0.0, 1.0, 0.0], [1.0, 1.0, 0.5], [0.5, 1.0, 1.0], [0.2, 0.0, 0.3]])
+    options = np.array([0, 1, 2, 0, 1, 2])
+    learned = learn_descriptors(table, options, np.array([1.0, 2.0, 3.0, 1.5, 2.5, 2.0]))
+    assert learned is not None and np.isfinite(learned.table).all()
+    assert not learned.kept[1] and learned.correlations[1] == 0.0 and learned.relevance[1] == 0.0
+    assert learned.kept[[0, 2]].any() and learned.relevance.sum() == 1.0
+
+
+def test_batched_learning_equals_learning_each_parameter_alone():
+    rng = np.random.default_rng(1)
+    target = rng.uniform(size=30)
+    problems = [(rng.uniform(size=(k, m)), rng.integers(0, k, 30)) for k, m in [(2, 4), (8, 7), (11, 7), (5, 3)]]
+    together = learn_many(problems, target)
+    assert sum(r is not None for r in together) >= 3
+    for problem, result in zip(problems, together):
+        alone = learn_descriptors(*problem, target)
+        assert (result is None) == (alone is None)
+        if result is not None:
+            np.testing.assert_allclose(result.table, alone.table, atol=1e-12)
+            np.testing.assert_array_equal(result.kept, alone.kept)
+            np.testing.assert_allclose(result.relevance, alone.relevance, atol=1e-12)
 
 
 def test_planner_with_dynamic_descriptors_reports_relevance_and_finds_the_optimum():
