@@ -14,18 +14,11 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from .kernel_density import DTYPE, KernelDensity
-from .space import SearchSpace
+from .kernel_density import DTYPE, KernelDensity, split
 
 CUTOFF = 50.0
 # Largest number of (candidate, kernel) pairs in one dense pass; bounds memory for large n and many candidates.
 CHUNK_ELEMENTS = 2_000_000
-
-
-def split(space: SearchSpace, X: np.ndarray) -> tuple[torch.Tensor, torch.Tensor]:
-    """(M, D) internal points -> continuous coordinates (M, C) float and option indices (M, F) long."""
-    return (torch.as_tensor(X[:, space.cont_idx], dtype=DTYPE),
-            torch.as_tensor(np.rint(X[:, space.finite_idx]), dtype=torch.long))
 
 
 class Acquisition:

@@ -215,6 +215,7 @@ class KnownConstraints:
         self.constraints = list(constraints)
         self.complete_columns = complete_columns
         self.complete_row = complete_row
+        self._halfspaces: tuple[tuple[np.ndarray, np.ndarray, bool] | None] | None = None  # computed once
 
     @classmethod
     def build(cls, space: SearchSpace, specs: Sequence[Any] = (),
@@ -242,6 +243,11 @@ class KnownConstraints:
     def halfspaces(self) -> tuple[np.ndarray, np.ndarray, bool] | None:
         """The linear constraints as A u <= b over the internal coordinates (all dims; finite dims get 0), and whether
         they are all the constraints there are; None when no constraint is linear."""
+        if self._halfspaces is None:
+            self._halfspaces = (self._linear_rows(),)
+        return self._halfspaces[0]
+
+    def _linear_rows(self) -> tuple[np.ndarray, np.ndarray, bool] | None:
         rows, rhs = [], []
         for c in self.constraints:
             for coefs, bound in c.linear or []:

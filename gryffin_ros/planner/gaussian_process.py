@@ -17,8 +17,8 @@ from functools import partial
 import numpy as np
 import torch
 
-from .acquisition import split
 from .errors import ConfigError
+from .kernel_density import split
 from .space import SearchSpace
 
 DTYPE = torch.float64

@@ -54,6 +54,12 @@ def mirror(space: SearchSpace, X: np.ndarray, values: np.ndarray) -> tuple[np.nd
     return np.concatenate(points), np.concatenate(out_values)
 
 
+def split(space: SearchSpace, X: np.ndarray) -> tuple[torch.Tensor, torch.Tensor]:
+    """(M, D) internal points -> continuous coordinates (M, C) float and option indices (M, F) long."""
+    return (torch.as_tensor(X[:, space.cont_idx], dtype=DTYPE),
+            torch.as_tensor(np.rint(X[:, space.finite_idx]), dtype=torch.long))
+
+
 def concrete_table(observed: np.ndarray, n_options: int, temperature: float, descriptors: np.ndarray | None,
                    generator: torch.Generator, draws: int = CONCRETE_DRAWS) -> torch.Tensor:
     """Averaged categorical kernels of one finite dim.
@@ -138,10 +144,8 @@ class KernelDensity:
     def leave_one_out(self) -> np.ndarray:
         """(n,) kernel regression at each observation from the kernels of all other observations (its mirrored
         copies left out too)."""
-        X, n = self.observed, len(self.observed)
-        xc = torch.as_tensor(X[:, self.space.cont_idx], dtype=DTYPE)
-        xf = torch.as_tensor(np.rint(X[:, self.space.finite_idx]), dtype=torch.long)
+        n = len(self.observed)
         with torch.no_grad():
-            log_p = self.log_kernels(xc, xf)
+            log_p = self.log_kernels(*split(self.space, self.observed))
             log_p[torch.as_tensor(self.origin)[None, :] == torch.arange(n)[:, None]] = -math.inf
             return (torch.softmax(log_p, dim=1) @ self.merits).numpy()
