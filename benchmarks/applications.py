@@ -3,10 +3,13 @@
 - flow reactor (examples/flow_reactor.yaml, BNN emulator): best-so-far by the Chimera hierarchy (X1 + X2 >= 0.9, then
   cost); reported: cost of the best experiment at iteration 100 and how many runs reached X1 + X2 >= 0.9.
 - redox candidates (examples/redox_flow_battery.yaml, DFT lookup): experiments until the best synthesizable candidate
-  (R1_0, R3_7, R4_7, R5_0) is measured, with dynamic descriptors, static descriptors and none.
+  (R1_0, R3_7, R4_7, R5_0) is measured, with dynamic descriptors, static descriptors and none (the example's three
+  sampling strategies), and `dynamic-2s`: dynamic descriptors with the paper's two alternating strategies.
 
     python benchmarks/applications.py [--seeds 20] [--processes 2] [--data ../shared/data] [--out benchmarks/results]
-                                      [--flow adam,gp,auto]   (flow-reactor surrogates: kde with Adam, gp, auto)
+        [--flow genetic,adam,gp,auto]           flow-reactor variants: the kernel density with the Genetic (the
+                                                example's) or the Adam optimizer; the GP or auto surrogate with Adam
+        [--redox dynamic,static,no,dynamic-2s]  redox variants (default: the first three)
 
 Per-run results go to <out>/applications_runs.json (resumable); the table to applications.md, plots to
 applications_flow.png and applications_redox.png.
@@ -29,14 +32,21 @@ from gryffin_ros.paths import share_path
 
 BUDGET = 100
 BEST_REDOX = ("R1_0", "R3_7", "R4_7", "R5_0")
-REDOX_VARIANTS = ("dynamic", "static", "no")
-FLOW_VARIANTS = {"adam": "gryffin_ros (Adam)", "gp": "gryffin_ros (GP)", "auto": "gryffin_ros (auto)"}
+REDOX_VARIANTS = {"dynamic": "dynamic descriptors", "static": "static descriptors", "no": "no descriptors",
+                  "dynamic-2s": "dynamic descriptors, 2 strategies"}
+# flow-reactor variants: overrides of the example's `general` section, and their label
+FLOW_VARIANTS = {"genetic": ({"acquisition_optimizer": "genetic"}, "gryffin_ros (Genetic)"),
+                 "adam": ({"acquisition_optimizer": "adam"}, "gryffin_ros (Adam)"),
+                 "gp": ({"acquisition_optimizer": "adam", "surrogate": "gp"}, "gryffin_ros (GP, Adam)"),
+                 "auto": ({"acquisition_optimizer": "adam", "surrogate": "auto"}, "gryffin_ros (auto, Adam)")}
 
 
 def redox_config(variant: str) -> dict:
     from gryffin_ros.planner.config import read_config
     config = read_config(share_path("examples") / "redox_flow_battery.yaml")
-    config["general"]["auto_desc_gen"] = variant == "dynamic"
+    config["general"]["auto_desc_gen"] = variant.startswith("dynamic")
+    if variant == "dynamic-2s":
+        config["general"]["sampling_strategies"] = 2
     if variant == "no":
         for parameter in config["parameters"]:
             parameter["options"] = list(parameter.pop("descriptors"))
@@ -54,8 +64,7 @@ def run(job: tuple[str, str, int]) -> dict:
     examples = share_path("examples")
     if app == "flow":
         config = read_config(examples / "flow_reactor.yaml")
-        if variant != "adam":
-            config.setdefault("general", {})["surrogate"] = variant
+        config.setdefault("general", {}).update(FLOW_VARIANTS[variant][0])
         planner, emulator = Planner(load_config(config, examples), seed=seed), FlowReactorEmulator(seed=seed)
     else:
         planner, emulator = Planner(load_config(redox_config(variant), examples), seed=seed), RedoxEmulator()
@@ -125,23 +134,29 @@ def main() -> None:
     parser.add_argument("--processes", type=int, default=2)
     parser.add_argument("--data", type=Path, default=Path(__file__).resolve().parents[2] / "shared" / "data")
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
-    parser.add_argument("--flow", default="adam", help="flow-reactor surrogates, comma separated: adam (kde), gp, auto")
+    parser.add_argument("--flow", default="genetic",
+                        help=f"flow-reactor variants, comma separated: {', '.join(FLOW_VARIANTS)}")
+    parser.add_argument("--redox", default="dynamic,static,no",
+                        help=f"redox variants, comma separated: {', '.join(REDOX_VARIANTS)}")
     args = parser.parse_args()
     flow_variants = [v for v in args.flow.split(",") if v]
+    redox_variants = [v for v in args.redox.split(",") if v]
     if set(flow_variants) - set(FLOW_VARIANTS):
         parser.error(f"--flow: choose from {', '.join(FLOW_VARIANTS)}")
+    if set(redox_variants) - set(REDOX_VARIANTS):
+        parser.error(f"--redox: choose from {', '.join(REDOX_VARIANTS)}")
     args.out.mkdir(parents=True, exist_ok=True)
     store = args.out / "applications_runs.json"
     done = {(r["app"], r["variant"], r["seed"]): r for r in (json.loads(store.read_text()) if store.exists() else [])}
     jobs = [("flow", v, s) for v in flow_variants for s in range(args.seeds)]
-    jobs += [("redox", v, s) for v in REDOX_VARIANTS for s in range(args.seeds)]
+    jobs += [("redox", v, s) for v in redox_variants for s in range(args.seeds)]
     with Pool(args.processes) as pool:
         for result in pool.imap_unordered(run, [j for j in jobs if j not in done]):
             done[(result["app"], result["variant"], result["seed"])] = result
             store.write_text(json.dumps(list(done.values())))
     ours = [r for key, r in done.items() if key in set(jobs)]
 
-    flows = {FLOW_VARIANTS[v]: [np.array([[t["X1_X2"], t["cost"]] for t in r["trace"]]) for r in ours
+    flows = {FLOW_VARIANTS[v][1]: [np.array([[t["X1_X2"], t["cost"]] for t in r["trace"]]) for r in ours
                                 if r["app"] == "flow" and r["variant"] == v] for v in flow_variants}
     paper = paper_flow(args.data)
     lines = [f"Flow reactor, {BUDGET} experiments: cost ($/min) of the best experiment by the Chimera hierarchy at "
@@ -150,24 +165,24 @@ def main() -> None:
     for name, traces in list(flows.items()) + [(f"paper: {k}", v) for k, v in sorted(paper.items())]:
         final = np.array([t[-1] for t in traces])
         se = final[:, 1].std(ddof=1) / np.sqrt(len(final)) if len(final) > 1 else float("nan")
-        lines.append(f"| {name} | {len(final)} | {final[:, 1].mean():.4f} ± {se:.4f} | "
+        lines.append(f"| {name} | {len(final)} | {final[:, 1].mean():.5f} ± {se:.5f} | "
                      f"{100 * (final[:, 0] >= 0.9).mean():.0f} % |")
     lines += ["", f"Redox candidates: runs that measured the best synthesizable candidate within {BUDGET} experiments "
               "and the median number of experiments to it.", "",
               "| strategy | runs | found | median experiments (all runs) | median (runs that found it) |",
               "|---|---|---|---|---|"]
-    for variant in REDOX_VARIANTS:
-        lines.append(redox_row(f"gryffin_ros, {variant} descriptors",
+    for variant in redox_variants:
+        lines.append(redox_row(f"gryffin_ros, {REDOX_VARIANTS[variant]}",
                                [r["found"] for r in ours if r["app"] == "redox" and r["variant"] == variant]))
     for strategy, found in sorted(paper_redox(args.data).items()):
         lines.append(redox_row(f"paper: {strategy}", found))
     text = "\n".join(lines) + "\n"
     (args.out / "applications.md").write_text(text)
     print(text)
-    plot(flows, paper, ours, paper_redox(args.data), args.out)
+    plot(flows, paper, ours, paper_redox(args.data), redox_variants, args.out)
 
 
-def plot(flows, paper, ours, paper_found, out: Path) -> None:
+def plot(flows, paper, ours, paper_found, redox_variants, out: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -183,7 +198,7 @@ def plot(flows, paper, ours, paper_found, out: Path) -> None:
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(6, 4))
     curves = {f"gryffin_ros {v}": [r["found"] for r in ours if r["app"] == "redox" and r["variant"] == v]
-              for v in REDOX_VARIANTS}
+              for v in redox_variants}
     curves.update({f"paper {k}": v for k, v in paper_found.items()})
     for name, found in curves.items():
         hits = [sum(1 for f in found if f is not None and f <= k) / len(found) for k in range(1, BUDGET + 1)]

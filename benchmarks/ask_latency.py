@@ -2,6 +2,10 @@
 parameters continuous in [0, 1], optionally constrained by sum(x) <= 0.5 d), for the Adam and Genetic optimizers.
 
     python benchmarks/ask_latency.py [--repeats 5] [--out benchmarks/results/ask_latency.md]
+
+With --applications: the shipped examples instead (flow reactor, redox candidates with dynamic and static
+descriptors), after n random feasible experiments measured by their emulators
+(default out benchmarks/results/ask_latency_applications.md).
 """
 
 from __future__ import annotations
@@ -50,16 +54,62 @@ def median_ask(n: int, d: int, optimizer: str, constrained: bool, repeats: int, 
     return statistics.median(times)
 
 
+def median_application_ask(example: str, general: dict, n: int, repeats: int, seed: int = 0) -> float:
+    """Median ask() seconds of a shipped example after n random feasible experiments measured by its emulator."""
+    from gryffin_ros.emulators import FlowReactorEmulator, RedoxEmulator
+    from gryffin_ros.paths import share_path
+    from gryffin_ros.planner.config import load_config, read_config
+    examples = share_path("examples")
+    config = read_config(examples / example)
+    config["general"].update(general)
+    planner = Planner(load_config(config, examples), seed=seed)
+    emulator = FlowReactorEmulator(seed=seed) if example.startswith("flow") else RedoxEmulator()
+    names = [o.name for o in planner.objectives]
+
+    def measured(params: dict) -> dict:
+        result = emulator.measure(params)
+        return {**params, **{k: result[k] for k in names}}
+
+    rng = np.random.default_rng(seed)
+    points = planner.random_points(n, rng, np.empty((0, planner.space.dim)))
+    planner.tell([measured(params) for params in planner.space.to_params(points)])
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        (proposal,) = planner.ask()
+        times.append(time.perf_counter() - start)
+        planner.tell({**measured(proposal.params), "experiment_id": proposal.experiment_id})
+    return statistics.median(times)
+
+
+APPLICATIONS = [("flow reactor, Genetic (the example)", "flow_reactor.yaml", {}),
+                ("flow reactor, Adam", "flow_reactor.yaml", {"acquisition_optimizer": "adam"}),
+                ("redox, dynamic descriptors (the example)", "redox_flow_battery.yaml", {}),
+                ("redox, static descriptors", "redox_flow_battery.yaml", {"auto_desc_gen": False})]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "ask_latency.md")
+    parser.add_argument("--applications", action="store_true", help="the shipped examples instead of the grid")
+    parser.add_argument("--out", type=Path)
     args = parser.parse_args()
-    rows = ["| n | d | Adam | Adam, constrained | Genetic | Genetic, constrained |", "|---|---|---|---|---|---|"]
-    for n, d in GRID:
-        cells = [f"{median_ask(n, d, opt, c, args.repeats):.3f}" for opt in ("adam", "genetic") for c in (False, True)]
-        rows.append(f"| {n} | {d} | " + " | ".join(cells) + " |")
-        print(rows[-1], flush=True)
+    results = Path(__file__).parent / "results"
+    if args.applications:
+        args.out = args.out or results / "ask_latency_applications.md"
+        rows = ["| example | n = 30 | n = 100 |", "|---|---|---|"]
+        for label, example, general in APPLICATIONS:
+            cells = [f"{median_application_ask(example, general, n, args.repeats):.3f}" for n in (30, 100)]
+            rows.append(f"| {label} | " + " | ".join(cells) + " |")
+            print(rows[-1], flush=True)
+    else:
+        args.out = args.out or results / "ask_latency.md"
+        rows = ["| n | d | Adam | Adam, constrained | Genetic | Genetic, constrained |", "|---|---|---|---|---|---|"]
+        for n, d in GRID:
+            cells = [f"{median_ask(n, d, opt, c, args.repeats):.3f}" for opt in ("adam", "genetic")
+                     for c in (False, True)]
+            rows.append(f"| {n} | {d} | " + " | ".join(cells) + " |")
+            print(rows[-1], flush=True)
     header = (f"Median ask() seconds over {args.repeats} asks; {platform.processor() or platform.machine()}, "
               f"{os.cpu_count()} cores, torch {torch.__version__} ({torch.get_num_threads()} threads).\n\n")
     args.out.parent.mkdir(parents=True, exist_ok=True)
