@@ -64,10 +64,11 @@ def learn_many(problems: Sequence[tuple[np.ndarray, np.ndarray]], target: np.nda
     results: list[LearnedDescriptors | None] = [None] * len(problems)
     if n < MIN_OBSERVATIONS or np.ptp(target) == 0:
         return results
+    observed = [descriptors[np.asarray(options, dtype=int)] for descriptors, options in problems]  # (N, m) each
     informative = {}  # problem -> indices of descriptors that vary over its observed options
-    for i, (descriptors, options) in enumerate(problems):
+    for i, (descriptors, _) in enumerate(problems):
         if descriptors.shape[1] >= 2:
-            varying = np.flatnonzero(np.ptp(descriptors[np.asarray(options, dtype=int)], axis=0) > 0)
+            varying = np.flatnonzero(np.ptp(observed[i], axis=0) > 0)
             if varying.size:
                 informative[i] = varying
     if not informative:
@@ -77,9 +78,8 @@ def learn_many(problems: Sequence[tuple[np.ndarray, np.ndarray]], target: np.nda
     x = torch.zeros((B, n, M), dtype=torch.float64)
     mask = torch.zeros((B, M), dtype=torch.float64)
     for j, i in enumerate(order):
-        descriptors, options = problems[i]
         cols = informative[i]
-        x[j, :, :len(cols)] = torch.as_tensor(descriptors[np.asarray(options, dtype=int)][:, cols])
+        x[j, :, :len(cols)] = torch.as_tensor(observed[i][:, cols])
         mask[j, :len(cols)] = 1.0
     counts = mask.sum(1)
     square = mask[:, :, None] * mask[:, None, :]
@@ -112,19 +112,19 @@ def learn_many(problems: Sequence[tuple[np.ndarray, np.ndarray]], target: np.nda
         correlations = torch.nan_to_num(_pearson(transform(x), y, 1.0 - mask)[:, :, 0]).numpy()
         W, b = weights.numpy(), bias.numpy()
     for j, i in enumerate(order):
-        results[i] = _result(problems[i], informative[i], W[j], b[j], correlations[j], n, target)
+        results[i] = _result(problems[i][0], observed[i], informative[i], W[j], b[j], correlations[j], target)
     return results
 
 
-def _result(problem: tuple[np.ndarray, np.ndarray], cols: np.ndarray, W: np.ndarray, b: np.ndarray,
-            correlations: np.ndarray, n: int, target: np.ndarray) -> LearnedDescriptors | None:
-    descriptors, options = problem
-    k = len(cols)
+def _result(descriptors: np.ndarray, observed: np.ndarray, cols: np.ndarray, W: np.ndarray, b: np.ndarray,
+            correlations: np.ndarray, target: np.ndarray) -> LearnedDescriptors | None:
+    """One problem's learned table from its block of the batched weights (its first len(cols) rows and columns)."""
+    n, k = len(target), len(cols)
     W, b, r = W[:k, :k], b[:k], correlations[:k]
     kept = np.abs(r) > 1.0 / math.sqrt(n - 2)
     if not kept.any():
         return None
-    x = descriptors[np.asarray(options, dtype=int)][:, cols]
+    x = observed[:, cols]
     z = x @ W + b
     gen = z / (1.0 + np.abs(z))
     # relevance: how strongly a least-squares fit of the target on the kept columns responds to each original
