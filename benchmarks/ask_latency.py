@@ -44,13 +44,18 @@ def median_ask(n: int, d: int, optimizer: str, constrained: bool, repeats: int, 
     X = X[:n]
     planner.tell([{**{f"x{i}": float(v) for i, v in enumerate(x)}, "y": objective(x)} for x in X])
     _ = planner.feasible_fraction  # estimated once per campaign, not per ask
+    return median_timed_asks(planner, repeats, lambda params: {
+        **params, "y": objective(np.array([params[f"x{i}"] for i in range(d)]))})
+
+
+def median_timed_asks(planner: Planner, repeats: int, measured) -> float:
+    """Median seconds of `repeats` ask() calls, each proposal told back as `measured(params)`."""
     times = []
     for _ in range(repeats):
         start = time.perf_counter()
         (proposal,) = planner.ask()
         times.append(time.perf_counter() - start)
-        x = np.array([proposal.params[f"x{i}"] for i in range(d)])
-        planner.tell({**proposal.params, "y": objective(x), "experiment_id": proposal.experiment_id})
+        planner.tell({**measured(proposal.params), "experiment_id": proposal.experiment_id})
     return statistics.median(times)
 
 
@@ -73,13 +78,7 @@ def median_application_ask(example: str, general: dict, n: int, repeats: int, se
     rng = np.random.default_rng(seed)
     points = planner.random_points(n, rng, np.empty((0, planner.space.dim)))
     planner.tell([measured(params) for params in planner.space.to_params(points)])
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        (proposal,) = planner.ask()
-        times.append(time.perf_counter() - start)
-        planner.tell({**measured(proposal.params), "experiment_id": proposal.experiment_id})
-    return statistics.median(times)
+    return median_timed_asks(planner, repeats, measured)
 
 
 APPLICATIONS = [("flow reactor, Genetic (the example)", "flow_reactor.yaml", {}),
