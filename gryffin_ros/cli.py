@@ -126,8 +126,7 @@ def run_ros(config_path: str, config: PlannerConfig, store: CampaignStore, args:
     env["ROS_LOG_DIR"] = str(out / "ros_logs")
     seed = -1 if seed is None else seed
     planner_cmd = [sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args",
-                   "-p", f"config:={config_path}", "-p", f"storage:={store.path}", "-p", f"seed:={seed}",
-                   "-p", f"acquisition_optimizer:={config.general.acquisition_optimizer}"]
+                   "-p", f"config:={config_path}", "-p", f"storage:={store.path}", "-p", f"seed:={seed}"]
     emulator_cmd = [sys.executable, "-m", "gryffin_ros.nodes.emulator_node", kind, "--ros-args",
                     "-p", f"seed:={seed}", "-p", f"experiment_time_s:={args.experiment_time}",
                     "-p", f"objectives:=[{','.join(objectives)}]"]

@@ -31,7 +31,7 @@ PARAMETERS = {
     "config": ("", "path to the campaign config (YAML or JSON; Gryffin format accepted); required"),
     "storage": ("", "SQLite file holding the campaign (default <campaign name>.sqlite); ':memory:' for none"),
     "batch_size": (1, "proposals per recommendation"),
-    "acquisition_optimizer": ("adam", "'adam' (Adam + Hill) or 'genetic'"),
+    "acquisition_optimizer": ("", "'adam' (Adam + Hill) or 'genetic'; empty: as the config's general section says"),
     "seed": (-1, "random seed; -1 = random (kept in the store, so a restart continues with it)"),
     "auto_propose": (True, "publish the next proposals as soon as all pending experiments have reported"),
     "accept_unsolicited": (False, "accept observations whose experiment_id this planner never proposed"),
@@ -60,8 +60,8 @@ class PlannerNode(Node):
             raise StartupError("parameter 'config' is required (path to a YAML or JSON campaign config)")
         if p["batch_size"] < 1:
             raise StartupError(f"parameter 'batch_size' must be at least 1, got {p['batch_size']}")
-        if p["acquisition_optimizer"] not in ("adam", "genetic"):
-            raise StartupError(f"parameter 'acquisition_optimizer' must be 'adam' or 'genetic', got "
+        if p["acquisition_optimizer"] not in ("", "adam", "genetic"):
+            raise StartupError(f"parameter 'acquisition_optimizer' must be 'adam', 'genetic' or empty, got "
                                f"{p['acquisition_optimizer']!r}")
         self.batch_size, self.auto_propose = p["batch_size"], p["auto_propose"]
         self.accept_unsolicited = p["accept_unsolicited"]
@@ -79,7 +79,8 @@ class PlannerNode(Node):
         self.store.set_meta("seed", str(seed))
         # node parameters choose how to optimize, not what: they are applied after the campaign hash
         tuned = copy.deepcopy(config.raw)
-        tuned.setdefault("general", {})["acquisition_optimizer"] = p["acquisition_optimizer"]
+        if p["acquisition_optimizer"]:
+            tuned.setdefault("general", {})["acquisition_optimizer"] = p["acquisition_optimizer"]
         self.planner = self._restore(tuned, seed, base_dir)
         fraction = self.planner.feasible_fraction  # contradictory constraints fail here, before anything starts
 
@@ -117,7 +118,8 @@ class PlannerNode(Node):
         self._wake.trigger()
         self.get_logger().info(
             f"campaign '{self.campaign}' in {storage}: {len(self._reported)} observation(s), {len(self._pending)} "
-            f"pending; feasible fraction {fraction.value:.3g} ({fraction.method}); seed {seed}")
+            f"pending; feasible fraction {fraction.value:.3g} ({fraction.method}); seed {seed}; acquisition optimizer "
+            f"{self.planner.config.general.acquisition_optimizer}")
 
     def _restore(self, config: dict, seed: int, base_dir: Path) -> Planner:
         proposals = self.store.proposals()

@@ -125,6 +125,15 @@ def test_third_party_plugin_loads_and_a_raising_plugin_is_reported(client, start
     assert "'test_exploding' raised RuntimeError: interlock controller unreachable" in planner.output()
 
 
+def test_the_config_chooses_the_optimizer_unless_the_node_parameter_overrides_it(client, start_planner, tmp_path):
+    config = {**FLOW_CONFIG, "general": {"acquisition_optimizer": "genetic"}}
+    node = start_planner(config, storage=str(tmp_path / "a.sqlite"))
+    assert "acquisition optimizer genetic" in node.output()
+    assert node.stop() == 0
+    node = start_planner(config, storage=str(tmp_path / "b.sqlite"), acquisition_optimizer="adam")
+    assert "acquisition optimizer adam" in node.output()
+
+
 def test_bad_start_up_parameters_exit_with_a_message(tmp_path):
     env = node_env(tmp_path)
     result = subprocess.run([sys.executable, "-m", "gryffin_ros.nodes.planner_node"], env=env, capture_output=True,
