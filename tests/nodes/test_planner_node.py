@@ -126,12 +126,18 @@ def test_third_party_plugin_loads_and_a_raising_plugin_is_reported(client, start
 
 
 def test_the_config_chooses_the_optimizer_unless_the_node_parameter_overrides_it(client, start_planner, tmp_path):
+    def logged(node, text: str) -> bool:  # the start-up line may follow the first status by a moment
+        deadline = time.monotonic() + 10
+        while text not in node.output() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        return text in node.output()
+
     config = {**FLOW_CONFIG, "general": {"acquisition_optimizer": "genetic"}}
     node = start_planner(config, storage=str(tmp_path / "a.sqlite"))
-    assert "acquisition optimizer genetic" in node.output()
+    assert logged(node, "acquisition optimizer genetic")
     assert node.stop() == 0
     node = start_planner(config, storage=str(tmp_path / "b.sqlite"), acquisition_optimizer="adam")
-    assert "acquisition optimizer adam" in node.output()
+    assert logged(node, "acquisition optimizer adam")
 
 
 def test_bad_start_up_parameters_exit_with_a_message(tmp_path):
