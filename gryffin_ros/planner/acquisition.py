@@ -26,7 +26,6 @@ class Acquisition:
         self.density = density
         self.strategy = float(strategy)
 
-
     def _alpha(self, log_p: torch.Tensor, shift: torch.Tensor) -> torch.Tensor:
         # terms below e^-(2 CUTOFF) of the largest are set to exactly 0: they are far below float64 resolution of the
         # result, and left alone they become subnormal numbers, which slow exp and matmul down by ~100x on x86

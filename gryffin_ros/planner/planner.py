@@ -452,9 +452,10 @@ class Planner(BasePlanner):
         """Dynamic descriptors for each categorical dim with several descriptors (general.auto_desc_gen)."""
         if not self.config.general.auto_desc_gen:
             return {}
-        dims = [int(d) for d in self.space.finite_idx if self.space.parameters[d].kind == "categorical"
-                and self.space.descriptors(d) is not None and self.space.descriptors(d).shape[1] > 1]
-        results = learn_many([(self.space.descriptors(d), X[:, d].astype(int)) for d in dims], target)
+        tables = {int(d): self.space.descriptors(d) for d in self.space.finite_idx
+                  if self.space.parameters[d].kind == "categorical"}
+        dims = [d for d, table in tables.items() if table is not None and table.shape[1] > 1]
+        results = learn_many([(tables[d], X[:, d].astype(int)) for d in dims], target)
         return {d: result for d, result in zip(dims, results) if result is not None}
 
     def descriptor_summary(self) -> dict[str, dict[str, Any]]:
