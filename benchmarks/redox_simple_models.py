@@ -91,9 +91,9 @@ def gp_score(K: np.ndarray, observed: list[int], y: np.ndarray, acquisition: str
         return mu - 2 * sigma
     if acquisition == "ts":
         return mu + sigma * rng.standard_normal(len(mu))
-    z = torch.as_tensor((t.min() - mu) / sigma)
-    ei = sigma * (z.numpy() * torch.special.ndtr(z).numpy() + np.exp(-0.5 * z.numpy() ** 2) / np.sqrt(2 * np.pi))
-    return -ei
+    z = (t.min() - mu) / sigma
+    cdf = torch.special.ndtr(torch.as_tensor(z)).numpy()
+    return -sigma * (z * cdf + np.exp(-0.5 * z ** 2) / np.sqrt(2 * np.pi))
 
 
 def kernel(problem: Problem, model: str) -> np.ndarray:
@@ -124,7 +124,7 @@ def run(problem: Problem, model: str, seed: int, K: np.ndarray | None) -> int | 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=40)
-    parser.add_argument("--out", type=Path, default=Path("benchmarks/results/redox_simple_models.md"))
+    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "redox_simple_models.md")
     args = parser.parse_args()
     problem = Problem()
     lines = [f"Redox candidates, simple models ({args.seeds} seeds, {BUDGET} experiments): runs that measured the best "
