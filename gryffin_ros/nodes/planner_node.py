@@ -83,6 +83,9 @@ class PlannerNode(Node):
             tuned.setdefault("general", {})["acquisition_optimizer"] = p["acquisition_optimizer"]
         self.planner = self._restore(tuned, seed, base_dir)
         fraction = self.planner.feasible_fraction  # contradictory constraints fail here, before anything starts
+        self._warnings = self.planner.constraint_warnings
+        for text in self._warnings:
+            self.get_logger().warning(text)
 
         self._planner_lock = threading.Lock()
         self._state_lock = threading.Lock()
@@ -154,6 +157,7 @@ class PlannerNode(Node):
                 "n_failed": self._n_failed, "state": self._state,
                 "best": None if best is None else {"experiment_id": best.experiment_id, "params": best.params,
                                                    "objectives": best.objectives},
+                "warnings": list(self._warnings),
             }
 
     def _publish_status(self) -> None:

@@ -18,7 +18,8 @@ import numpy as np
 
 from .errors import ConfigError, ConstraintError, NoFeasiblePointError
 from .expressions import Expression, linear_inequalities
-from .space import SearchSpace
+from .literals import matches_option, option_list, suggestion, unknown_option
+from .space import Parameter, SearchSpace
 
 PLUGIN_GROUP = "gryffin_ros.constraints"
 ENUMERATION_LIMIT = 10**6
@@ -36,15 +37,20 @@ class NamedConstraint:
     columns_fn: Callable[[Mapping[str, np.ndarray]], np.ndarray] | None = None
     # when the constraint is exactly a set of linear half-spaces sum(coefs * x) <= rhs in users' units
     linear: list[tuple[dict[str, float], float]] | None = None
+    # made by the planner itself (an equality-solved parameter kept within its bounds), not written by the user
+    derived: bool = False
 
 
-def expression_constraint(options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
+Parameters = Mapping[str, Parameter]  # every parameter a constraint may name, by name
+
+
+def expression_constraint(options: Mapping[str, Any], parameters: Parameters) -> NamedConstraint:
     text = options.get("expression") if isinstance(options, Mapping) else None
-    expression = Expression(text, names)
+    expression = Expression(text, parameters, parameters)
     return NamedConstraint(text, expression, expression.evaluate)
 
 
-def flow_reactor_constraint(options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
+def flow_reactor_constraint(options: Mapping[str, Any], parameters: Parameters) -> NamedConstraint:
     """Flow limits of the C60 reactor: min_total < F_C + F_S < max_total, and each flow below ratio x the other."""
     allowed = {"min_total", "max_total", "ratio", "c60_flow", "sultine_flow"}
     unknown = set(options) - allowed
@@ -58,7 +64,7 @@ def flow_reactor_constraint(options: Mapping[str, Any], names: Sequence[str]) ->
     if not low < high:
         raise ConfigError(f"flow_reactor constraint: min_total ({low}) must be below max_total ({high})")
     text = f"{low!r} < {fc} + {fs} < {high!r} and {fc} < {ratio!r} * {fs} and {fs} < {ratio!r} * {fc}"
-    expression = Expression(text, names)
+    expression = Expression(text, parameters, parameters)
     return NamedConstraint(f"flow_reactor({text})", expression, expression.evaluate)
 
 
@@ -73,7 +79,7 @@ def _lookup_key(value: Any) -> Any:
         return text
 
 
-def lookup_constraint(options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
+def lookup_constraint(options: Mapping[str, Any], parameters: Parameters) -> NamedConstraint:
     """Feasible when the parameters form a row of a CSV of feasible combinations (e.g. synthesizable molecules).
 
     Options: ``file`` (CSV with a header) and ``columns`` (parameter -> CSV column; default: every parameter, by
@@ -85,19 +91,23 @@ def lookup_constraint(options: Mapping[str, Any], names: Sequence[str]) -> Named
     path = options.get("file")
     if not isinstance(path, str) or not path:
         raise ConfigError("lookup constraint: 'file' must name a CSV file of feasible rows")
-    columns = options.get("columns", {name: name for name in names})
+    columns = options.get("columns", {name: name for name in parameters})
     if not isinstance(columns, Mapping) or not columns:
         raise ConfigError("lookup constraint: 'columns' must map parameter names to CSV column names")
-    unknown = set(columns) - set(names)
+    unknown = sorted(set(columns) - set(parameters))
     if unknown:
-        raise ConfigError(f"lookup constraint: unknown parameter(s) {sorted(unknown)} in 'columns'")
+        raise ConfigError(f"lookup constraint: unknown parameter(s) {unknown} in 'columns'"
+                          f"{suggestion(unknown[0], list(parameters))}")
     try:
         with open(path, newline="") as handle:
             reader = csv.DictReader(handle)
             missing = set(columns.values()) - set(reader.fieldnames or [])
             if missing:
                 raise ConfigError(f"lookup constraint: '{path}' has no column(s) {sorted(missing)}")
-            rows = {tuple(_lookup_key(row[columns[n]]) for n in columns) for row in reader}
+            rows = set()
+            for row in reader:
+                rows.add(tuple(_lookup_cell(row, columns[n], parameters[n], path, reader.line_num)
+                               for n in columns))
     except OSError as exc:
         raise ConfigError(f"lookup constraint: cannot read '{path}': {exc.strerror}") from None
     if not rows:
@@ -113,20 +123,44 @@ def lookup_constraint(options: Mapping[str, Any], names: Sequence[str]) -> Named
     return NamedConstraint(f"lookup({Path(path).name}: {len(rows)} feasible rows)", member, evaluate)
 
 
+def _lookup_cell(row: Mapping[str, Any], column: str, parameter: Parameter, path: str, line: int) -> Any:
+    """One cell of a lookup table as a membership key; a value the parameter cannot take is a ConfigError naming the
+    line (a row that can never match would silently make its combination infeasible, or hide a typo)."""
+    cell = row.get(column)
+    where = f"lookup constraint: '{Path(path).name}' line {line}, column '{column}'"
+    if cell is None or not str(cell).strip():
+        raise ConfigError(f"{where} is empty")
+    key = _lookup_key(cell)
+    if parameter.kind == "categorical":
+        if key not in {_lookup_key(o) for o in parameter.options}:
+            raise ConfigError(f"{where}: {unknown_option(str(cell).strip(), parameter)}")
+        return key
+    if not isinstance(key, float) or not math.isfinite(key):
+        raise ConfigError(f"{where}: {str(cell).strip()!r} is not a number, and '{parameter.name}' is a "
+                          f"{parameter.kind} parameter")
+    if parameter.kind == "discrete" and not matches_option(key, parameter.options):
+        raise ConfigError(f"{where}: {key:g} is not an allowed value of '{parameter.name}' "
+                          f"(values: {option_list(parameter.options)}){suggestion(key, parameter.options)}")
+    if parameter.kind == "continuous" and not parameter.low <= key <= parameter.high:
+        raise ConfigError(f"{where}: {key:g} is outside the range of '{parameter.name}' "
+                          f"[{parameter.low:g}, {parameter.high:g}]")
+    return key
+
+
 BUILTIN_PLUGINS = {"expression": expression_constraint, "flow_reactor": flow_reactor_constraint,
                    "lookup": lookup_constraint}
 
 
-def load_plugin(name: str, options: Mapping[str, Any], names: Sequence[str]) -> NamedConstraint:
+def load_plugin(name: str, options: Mapping[str, Any], parameters: Parameters) -> NamedConstraint:
     """Instantiate a constraint plugin by name: a built-in or a factory registered under the entry-point group."""
     if not isinstance(options, Mapping):
         raise ConfigError(f"constraint plugin '{name}': 'options' must be a mapping")
     if name in BUILTIN_PLUGINS:
-        return BUILTIN_PLUGINS[name](options, names)
+        return BUILTIN_PLUGINS[name](options, parameters)
     found = [ep for ep in entry_points(group=PLUGIN_GROUP) if ep.name == name]
     if not found:
         available = sorted(set(BUILTIN_PLUGINS) | {ep.name for ep in entry_points(group=PLUGIN_GROUP)})
-        raise ConfigError(f"unknown constraint plugin '{name}'; available: {available}")
+        raise ConfigError(f"unknown constraint plugin '{name}'; available: {available}{suggestion(name, available)}")
     try:
         factory = found[0].load()
         constraint = factory(dict(options))
@@ -157,22 +191,27 @@ def line_limits(A: np.ndarray, b: np.ndarray, X: np.ndarray, V: np.ndarray) -> t
     return np.where(slope < 0, limit, -np.inf).max(axis=1), np.where(slope > 0, limit, np.inf).min(axis=1)
 
 
-def constraint_from_spec(spec: Any, position: int, names: Sequence[str]) -> NamedConstraint:
+def constraint_from_spec(spec: Any, position: int, parameters: Parameters) -> NamedConstraint:
     """A config entry: an expression string, ``{expression: ...}`` or ``{plugin: NAME, options: {...}}``."""
     if isinstance(spec, str):
-        return expression_constraint({"expression": spec}, names)
+        return expression_constraint({"expression": spec}, parameters)
     if isinstance(spec, Mapping):
         unknown = set(spec) - {"plugin", "options", "expression", "name"}
         if unknown:
             raise ConfigError(f"constraints[{position}]: unknown key(s) {sorted(unknown)}")
-        if "expression" in spec:
-            if "plugin" in spec:
-                raise ConfigError(f"constraints[{position}]: give 'expression' or 'plugin', not both")
-            constraint = expression_constraint(spec, names)
-        elif isinstance(spec.get("plugin"), str):
-            constraint = load_plugin(spec["plugin"], spec.get("options", {}), names)
-        else:
+        if "expression" in spec and "plugin" in spec:
+            raise ConfigError(f"constraints[{position}]: give 'expression' or 'plugin', not both")
+        if "expression" not in spec and not isinstance(spec.get("plugin"), str):
             raise ConfigError(f"constraints[{position}]: needs an 'expression' string or a 'plugin' name")
+        try:
+            if "expression" in spec:
+                constraint = expression_constraint(spec, parameters)
+            else:
+                constraint = load_plugin(spec["plugin"], spec.get("options", {}), parameters)
+        except ConfigError as exc:
+            if "name" not in spec:
+                raise
+            raise ConfigError(f"constraints[{position}] ('{spec['name']}'): {exc}") from None
         if "name" in spec:
             constraint.name = str(spec["name"])
         return constraint
@@ -220,10 +259,11 @@ class KnownConstraints:
     @classmethod
     def build(cls, space: SearchSpace, specs: Sequence[Any] = (),
               callables: Callable | Sequence[Callable] | None = None,
-              names: Sequence[str] | None = None) -> KnownConstraints:
-        """`names`: every parameter name a constraint may use (default: the space's)."""
-        names = space.names if names is None else names
-        constraints = [constraint_from_spec(s, i, names) for i, s in enumerate(specs)]
+              parameters: Sequence[Parameter] | None = None) -> KnownConstraints:
+        """`parameters`: every parameter a constraint may name (default: the space's; a planner adds those solved
+        from equalities)."""
+        by_name = {p.name: p for p in (space.parameters if parameters is None else parameters)}
+        constraints = [constraint_from_spec(s, i, by_name) for i, s in enumerate(specs)]
         continuous = {p.name for p in space.parameters if p.kind == "continuous"}
         for spec, constraint in zip(specs, constraints):
             text = expression_text(spec)
@@ -365,3 +405,35 @@ def estimate_feasible_fraction(constraints: KnownConstraints, rng: np.random.Gen
             f"(feasible fraction below ~{1 / drawn:.1e}); check that the constraints do not contradict each other")
     p = hits / drawn
     return FeasibleFraction(p, math.sqrt(p * (1 - p) / drawn), "monte_carlo", drawn, np.concatenate(kept))
+
+
+# Points on which each constraint is checked for excluding anything: all of a finite space up to this size (or up to
+# ENUMERATION_LIMIT for vectorized constraints), else this many uniform draws.
+VACUITY_SAMPLES = 20_000
+
+
+def vacuous_constraints(constraints: KnownConstraints, rng: np.random.Generator) -> list[str]:
+    """A warning for each constraint the user wrote that excludes no point of the domain: exactly over a finite
+    space, else over VACUITY_SAMPLES uniform draws. A constraint that constrains nothing is almost always a
+    mistake (a bound on the wrong parameter, a limit outside the range, a condition that can never hold)."""
+    space = constraints.space
+    size = space.finite_size
+    points = space.enumerate() if size is not None and size <= ENUMERATION_LIMIT else None
+    sample = None
+    out = []
+    for c in constraints.constraints:
+        if c.derived:
+            continue
+        exact = points is not None and (len(points) <= VACUITY_SAMPLES or c.columns_fn is not None)
+        if exact:
+            X = points
+        else:
+            sample = space.sample(rng, VACUITY_SAMPLES) if sample is None else sample
+            X = sample
+        one = KnownConstraints(space, [c], constraints.complete_columns, constraints.complete_row)
+        if one.feasible(X).all():
+            where = (f"any of the {len(X)} points of the search space" if exact
+                     else f"any of {len(X)} uniform samples of the domain")
+            out.append(f"known constraint '{c.name}' excludes no point: it holds at {where}; check it for a "
+                       "mistake (a limit outside the parameter's range, a condition that never applies)")
+    return out

@@ -31,6 +31,7 @@ import numpy as np
 from .constraints import NamedConstraint, expression_text
 from .errors import ConfigError, ObservationError
 from .expressions import NotLinear, difference, linear_form
+from .literals import suggestion
 from .space import SearchSpace
 
 # Relative tolerance when checking that a reported observation satisfies the equalities.
@@ -82,7 +83,9 @@ class LinearEqualities:
             mentioned = {n.id for side in sides for n in ast.walk(side) if isinstance(n, ast.Name)}
             used = mentioned & every
             if used & continuous and mentioned - every:
-                raise ConfigError(f"{where} '{text}': unknown parameter(s) {sorted(mentioned - every)}")
+                unknown = sorted(mentioned - every)
+                raise ConfigError(f"{where} '{text}': unknown parameter(s) {unknown}"
+                                  f"{suggestion(unknown[0], sorted(every))}")
             if not used & continuous:
                 rest.append(spec)  # an equality on finite parameters only: sampled like any expression
                 continue
@@ -120,7 +123,8 @@ class LinearEqualities:
             raise ConfigError(f"{where}: mixture 'components' must list at least two distinct parameter names")
         not_continuous = [c for c in components if c not in continuous]
         if not_continuous:
-            raise ConfigError(f"{where}: mixture components {not_continuous} are not continuous parameters")
+            raise ConfigError(f"{where}: mixture components {not_continuous} are not continuous parameters "
+                              f"(continuous: {sorted(continuous)}){suggestion(not_continuous[0], sorted(continuous))}")
         total = body.get("total", 1.0)
         if isinstance(total, bool) or not isinstance(total, (int, float)) or not math.isfinite(total):
             raise ConfigError(f"{where}: mixture 'total' must be a finite number, got {total!r}")
@@ -130,7 +134,8 @@ class LinearEqualities:
         extra_constraints = []
         for name, pair in bounds.items():
             if name not in components:
-                raise ConfigError(f"{where}: mixture bound for '{name}', which is not a component")
+                raise ConfigError(f"{where}: mixture bound for '{name}', which is not a component "
+                                  f"(components: {list(components)}){suggestion(name, list(components))}")
             if (not isinstance(pair, (list, tuple)) or len(pair) != 2
                     or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
                                for v in pair) or pair[0] > pair[1]):
@@ -227,7 +232,8 @@ class LinearEqualities:
             def one(params: Mapping[str, Any], fn=within) -> bool:
                 return bool(fn({k: np.asarray([v]) for k, v in params.items()})[0])
 
-            constraint = NamedConstraint(f"{name} = {self.formula(i)} within [{p.low:g}, {p.high:g}]", one, within)
+            constraint = NamedConstraint(f"{name} = {self.formula(i)} within [{p.low:g}, {p.high:g}]", one, within,
+                                         derived=True)
             coefs = {n: float(c) for n, c in zip(self.free, self.matrix[i]) if c != 0.0}
             # low <= offset - coefs.x <= high  <=>  coefs.x <= offset - low  and  -coefs.x <= high - offset
             constraint.linear = [(coefs, float(self.offset[i] - p.low)),

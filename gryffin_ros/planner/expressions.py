@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ConfigError
+from .literals import check_literals, suggestion
 
 Columns = Mapping[str, np.ndarray]
 Node = Callable[[Columns], Any]
@@ -40,9 +41,13 @@ _FUNCTIONS: dict[str, tuple[Callable, int, int | None]] = {
 
 
 class Expression:
-    """A compiled constraint expression; ``evaluate(columns)`` returns a boolean array, one entry per row."""
+    """A compiled constraint expression; ``evaluate(columns)`` returns a boolean array, one entry per row.
 
-    def __init__(self, text: str, names: Iterable[str]):
+    `names` are the parameter names it may use. Given `parameters` (name -> parameter definition), every literal
+    compared with a parameter must be something that parameter can take (see `literals.check_literals`).
+    """
+
+    def __init__(self, text: str, names: Iterable[str], parameters: Mapping[str, Any] | None = None):
         if not isinstance(text, str) or not text.strip():
             raise ConfigError(f"a constraint expression must be a non-empty string, got {text!r}")
         self.text = text
@@ -53,6 +58,8 @@ class Expression:
             raise ConfigError(f"constraint {text!r} is not a valid expression: {exc.msg}") from None
         self.variables: set[str] = set()
         self._root = self._compile(tree.body)
+        if parameters is not None:
+            check_literals(tree.body, text, parameters)
 
     def evaluate(self, columns: Columns) -> np.ndarray:
         """Boolean array: True where the row satisfies the expression. Raises TypeError/ValueError on misuse."""
@@ -85,7 +92,7 @@ class Expression:
             name = node.id
             if name not in self._names:
                 raise ConfigError(f"constraint {self.text!r}: unknown name '{name}'; parameters are "
-                                  f"{sorted(self._names)}")
+                                  f"{sorted(self._names)}{suggestion(name, sorted(self._names))}")
             self.variables.add(name)
             return lambda cols: cols[name]
         if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:

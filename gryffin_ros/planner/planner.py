@@ -7,6 +7,7 @@ JSON state live in :class:`BasePlanner`.
 
 from __future__ import annotations
 
+import logging
 import math
 import secrets
 import uuid
@@ -22,7 +23,7 @@ from .acquisition import Acquisition
 from .adam_hill import AdamHillOptimizer
 from .chimera import Chimera
 from .config import PlannerConfig, load_config
-from .constraints import FeasibleFraction, KnownConstraints, estimate_feasible_fraction
+from .constraints import FeasibleFraction, KnownConstraints, estimate_feasible_fraction, vacuous_constraints
 from .descriptors import LearnedDescriptors, learn_many
 from .equalities import LinearEqualities
 from .errors import ConfigError, ExhaustedSpaceError, NoFeasiblePointError, ObservationError
@@ -34,6 +35,8 @@ from .selection import duplicates, select
 
 if TYPE_CHECKING:  # the GP module (and BoTorch, ~0.4 s to import) is loaded only by planners that use it
     from .gaussian_process import GaussianProcess, GPAcquisition
+
+logger = logging.getLogger(__name__)
 
 STATE_FORMAT = 1
 # Finite spaces with at most this many feasible points are searched exhaustively instead of from random starts.
@@ -117,7 +120,7 @@ class BasePlanner:
         self.equalities, specs = LinearEqualities.split(self.config.constraint_specs, full)
         self.space = self.equalities.reduced_space(full) if self.equalities else full
         self.objectives = self.config.objectives
-        self.constraints = KnownConstraints.build(self.space, specs, known_constraints, names=full.names)
+        self.constraints = KnownConstraints.build(self.space, specs, known_constraints, parameters=full.parameters)
         if self.equalities:  # the solved parameters' bounds first; every check sees the solved parameters too
             self.constraints = KnownConstraints(
                 self.space, self.equalities.bound_constraints(full) + self.constraints.constraints,
@@ -136,6 +139,7 @@ class BasePlanner:
         self._proposal_count = 0
         self._feasible_fraction: FeasibleFraction | None = None
         self._feasible_set: np.ndarray | None = None
+        self._constraint_warnings: list[str] | None = None
 
     def _complete(self, params: Mapping[str, Any]) -> dict[str, Any]:
         """The modelled parameters of a point -> all parameters (equality-solved ones computed), in config order."""
@@ -158,9 +162,21 @@ class BasePlanner:
 
     # ---- feasible set ----------------------------------------------------------------------------------------
     @property
+    def constraint_warnings(self) -> list[str]:
+        """One warning per known constraint that excludes no point of the domain (computed once, and logged then:
+        a constraint that constrains nothing is almost always a mistake)."""
+        if self._constraint_warnings is None:
+            self._constraint_warnings = vacuous_constraints(self.constraints, np.random.default_rng([self.seed, 3]))
+            for text in self._constraint_warnings:
+                logger.warning(text)
+        return list(self._constraint_warnings)
+
+    @property
     def feasible_fraction(self) -> FeasibleFraction:
-        """V_C: given in the config, exact for finite spaces up to 10^6 points, else Monte Carlo (cached)."""
+        """V_C: given in the config, exact for finite spaces up to 10^6 points, else Monte Carlo (cached). The first
+        time, constraints that exclude nothing are also looked for (`constraint_warnings`)."""
         if self._feasible_fraction is None:
+            self.constraint_warnings  # noqa: B018 - computed (and logged) when the campaign's domain is first studied
             given = self.config.general.feasible_fraction
             if given is not None:
                 self._feasible_fraction = FeasibleFraction(float(given), 0.0, "given")
@@ -326,6 +342,7 @@ class BasePlanner:
         """Gryffin-compatible and stateless: parameter dicts for the given observations, one per (batch, strategy)."""
         fresh = type(self)(self.config, self._known_constraints, self.seed)
         fresh._feasible_fraction, fresh._feasible_set = self._feasible_fraction, self._feasible_set
+        fresh._constraint_warnings = self._constraint_warnings
         if observations:
             fresh.tell(list(observations))
         general = self.config.general

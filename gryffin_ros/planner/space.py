@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ConfigError, ObservationError
+from .literals import suggestion
 
 
 @dataclass(frozen=True)
@@ -73,9 +74,10 @@ def _number(spec: Mapping, key: str, where: str) -> float:
 
 
 def _rescale_descriptors(name: str, options: Sequence[str], table: Mapping) -> np.ndarray | None:
-    unknown = set(table) - set(options)
+    unknown = [key for key in table if key not in options]
     if unknown:
-        raise ConfigError(f"parameter '{name}': descriptors given for unknown options {sorted(unknown)}")
+        raise ConfigError(f"parameter '{name}': descriptors given for {unknown[0]!r}, which is not one of its options "
+                          f"({', '.join(repr(o) for o in options)}){suggestion(unknown[0], list(options))}")
     rows = [table.get(option) for option in options]
     if all(row is None for row in rows):
         return None

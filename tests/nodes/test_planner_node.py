@@ -151,6 +151,25 @@ def test_bad_start_up_parameters_exit_with_a_message(tmp_path):
                              f"config:={config}", "-p", "storage:=\":memory:\""], env=env, capture_output=True,
                             text=True, timeout=60)
     assert result.returncode == 2 and "no point satisfying the known constraints" in result.stderr
+    config.write_text(json.dumps({**FLOW_CONFIG, "parameters": [*FLOW_CONFIG["parameters"], SOLVENT],
+                                  "constraints": ["T < 66 if solvent == 'thf' else T < 150"]}))
+    result = subprocess.run([sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-p",
+                             f"config:={config}", "-p", "storage:=\":memory:\""], env=env, capture_output=True,
+                            text=True, timeout=60)
+    assert result.returncode == 2 and "'thf' is not an option of 'solvent'" in result.stderr
+    assert "did you mean 'THF'?" in result.stderr
+
+
+SOLVENT = {"name": "solvent", "type": "categorical", "options": ["THF", "DMF"]}
+
+
+def test_a_constraint_that_excludes_nothing_is_logged_and_in_the_status(client, start_planner):
+    config = {**FLOW_CONFIG, "parameters": [*FLOW_CONFIG["parameters"], SOLVENT],
+              "constraints": [*FLOW_CONFIG["constraints"], "T < 160 if solvent == 'THF' else T < 200"]}
+    node = start_planner(config, auto_propose=False)
+    [warning] = client.status()["warnings"]
+    assert "'T < 160 if solvent == 'THF' else T < 200' excludes no point" in warning
+    assert warning in node.output()
 
 
 BLEND_CONFIG = {
