@@ -1,24 +1,38 @@
 # The two commands of the README: `make demo` runs the main job, `make test` the test suite. Each first creates or
-# refreshes the local virtual environment (torch pinned through constraints.txt, then the package with its test,
-# ROS 2 and GP extras).
+# refreshes the local virtual environment with exactly the package set of requirements.lock (the set the suite
+# passed with), then the package itself with its test, ROS 2 and GP extras.
+# `make lock` regenerates requirements.lock: a fresh environment resolved from the deliberate pins of
+# constraints.txt alone, frozen.
 VENV ?= .venv
 PYTHON ?= python3
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+LOCK := requirements.lock
+EXTRAS := .[test,ros,gp]
 
 # DDS stays on loopback in every process started from here (SPEC section 6), with the fast-discovery profile.
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export FASTRTPS_DEFAULT_PROFILES_FILE := $(CURDIR)/gryffin_ros/resources/fastdds_profile.xml
 export RMW_IMPLEMENTATION := rmw_fastrtps_cpp
 
-.PHONY: venv demo test lint
+.PHONY: venv demo test lint lock
 
-$(STAMP): setup.py constraints.txt
+$(STAMP): setup.py constraints.txt $(LOCK)
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt torch==2.13.0
-	$(PY) -m pip install --quiet -c constraints.txt -e '.[test,ros,gp]'
+	$(PY) -m pip install --quiet -c $(LOCK) pip
+	$(PY) -m pip install --quiet -c $(LOCK) torch
+	$(PY) -m pip install --quiet -c $(LOCK) -e '$(EXTRAS)'
 	touch $(STAMP)
+
+lock:
+	rm -rf .venv-lock
+	$(PYTHON) -m venv .venv-lock
+	.venv-lock/bin/python -m pip install --quiet --upgrade pip
+	.venv-lock/bin/python -m pip install --quiet -c constraints.txt torch
+	.venv-lock/bin/python -m pip install --quiet -c constraints.txt -e '$(EXTRAS)'
+	{ echo "# The exact package set the test suite passed with; make installs it (pip -c). Regenerate: make lock"; \
+	  .venv-lock/bin/python -m pip freeze --all --exclude-editable; } > $(LOCK)
+	rm -rf .venv-lock
 
 venv: $(STAMP)
 
