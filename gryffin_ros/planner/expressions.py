@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ConfigError
-from .literals import check_literals, suggestion
+from .literals import check_literals, literal_values, suggestion
 
 Columns = Mapping[str, np.ndarray]
 Node = Callable[[Columns], Any]
@@ -125,11 +125,9 @@ class Expression:
         ops = []
         for op, comparator in zip(node.ops, node.comparators):
             if isinstance(op, (ast.In, ast.NotIn)):
-                if not isinstance(comparator, (ast.Tuple, ast.List)) or not all(
-                        isinstance(e, ast.Constant) and isinstance(e.value, (int, float, str))
-                        for e in comparator.elts):
+                members = literal_values(comparator) if isinstance(comparator, (ast.Tuple, ast.List)) else None
+                if members is None or any(isinstance(e, ast.IfExp) for e in comparator.elts):
                     raise self._reject(comparator, "'in' with anything but a literal list")
-                members = [e.value for e in comparator.elts]
                 negate = isinstance(op, ast.NotIn)
                 ops.append(lambda a, b, members=members, negate=negate:
                            np.isin(np.asarray(a, dtype=object), members) != negate)

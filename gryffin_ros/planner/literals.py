@@ -68,21 +68,21 @@ def matches_option(value: float, options: Sequence[Any]) -> bool:
     return any(abs(float(o) - value) <= MATCH_TOLERANCE * max(1.0, abs(value)) for o in options)
 
 
-def _literals(node: ast.AST) -> list[Any] | None:
+def literal_values(node: ast.AST) -> list[Any] | None:
     """The values a literal operand can take: a constant, a negated number, ``a if c else b`` of literals, or the
     list/tuple after ``in``; None for anything that is not literal."""
     if isinstance(node, ast.Constant) and isinstance(node.value, (int, float, str)):
         return [node.value]
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
-        inner = _literals(node.operand)
+        inner = literal_values(node.operand)
         if inner is not None and all(is_number(v) for v in inner):
             return [-v if isinstance(node.op, ast.USub) else v for v in inner]
         return None
     if isinstance(node, ast.IfExp):
-        body, orelse = _literals(node.body), _literals(node.orelse)
+        body, orelse = literal_values(node.body), literal_values(node.orelse)
         return None if body is None or orelse is None else body + orelse
     if isinstance(node, (ast.Tuple, ast.List)):
-        values = [_literals(e) for e in node.elts]
+        values = [literal_values(e) for e in node.elts]
         return None if any(v is None for v in values) else [x for v in values for x in v]
     return None
 
@@ -140,7 +140,7 @@ def check_literals(tree: ast.AST, text: str, parameters: Mapping[str, Any]) -> N
         operands = [node.left, *node.comparators]
         for op, left, right in zip(node.ops, operands, operands[1:]):
             problem = None
-            right_values, left_values = _literals(right), _literals(left)
+            right_values, left_values = literal_values(right), literal_values(left)
             if right_values is not None and left_values is None:
                 problem = _check_pair(left, op, right_values, parameters)
             elif left_values is not None and right_values is None:

@@ -32,6 +32,7 @@ def test_functions_and_boolean_operators():
 def test_membership_in_a_literal_list():
     assert evaluate("solvent in ('THF', 'MeCN')", solvent=["THF", "DMF", "MeCN"]) == [True, False, True]
     assert evaluate("solvent not in ['THF']", solvent=["THF", "DMF"]) == [False, True]
+    assert evaluate("F_C in [-1, 2.5]", F_C=[-1.0, 1.0, 2.5]) == [True, False, True]  # negative numbers are literals
 
 
 def test_single_point_call():
