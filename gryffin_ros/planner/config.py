@@ -8,6 +8,7 @@ from __future__ import annotations
 import copy
 import hashlib
 import json
+import logging
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -17,11 +18,30 @@ from typing import Any
 import yaml
 
 from .errors import ConfigError
+from .notices import note_no_effect
 from .space import SearchSpace
 
-TOP_LEVEL_KEYS = {"name", "general", "parameters", "objectives", "constraints", "database"}
-# Gryffin keys we accept for compatibility; they change nothing here (ours has no such knob) and are documented.
-GRYFFIN_NO_OP_KEYS = {"num_cpus", "boosted", "caching", "save_database", "verbosity", "backend", "parallel"}
+TOP_LEVEL_KEYS = {"name", "general", "parameters", "objectives", "constraints", "database", "model"}
+# Gryffin 1.0 keys we accept for compatibility; they change nothing here (ours has no such knob): each is logged once
+# per process as having no effect, with the reason below, and documented in the README.
+_NO_BNN = "there is no Bayesian neural network here; kernels are placed on the observations directly"
+_NO_DATABASE = ("Gryffin's database is not written here; the observations are what you pass in, and campaigns run "
+                "by the ROS node are kept in the campaign store (gryffin-ros export)")
+GRYFFIN_NO_OP_KEYS = {
+    "num_cpus": "proposals are computed in this process, vectorized; no worker processes are started",
+    "parallel": "proposals are computed in this process, vectorized; no worker processes are started",
+    "boosted": "it sets the lower probability bound of Gryffin's BNN kernels; " + _NO_BNN,
+    "caching": "it caches Gryffin's BNN kernel evaluations; " + _NO_BNN,
+    "backend": "it chooses the framework of Gryffin's BNN; " + _NO_BNN,
+    "save_database": _NO_DATABASE,
+    "verbosity": "nothing is printed; messages go through Python's logging module",
+    "reject_tol": "rejection sampling is bounded by general.max_rejection_draws, and small feasible regions are "
+                  "sampled by walks inside them instead of giving up",
+}
+# Gryffin 1.0's `database` and `model` (BNN) sections: every key is accepted and has no effect here.
+GRYFFIN_DATABASE_KEYS = {"format", "path", "log_observations", "log_runtimes"}
+GRYFFIN_MODEL_KEYS = {"num_epochs", "learning_rate", "num_draws", "num_layers", "hidden_shape", "weight_loc",
+                      "weight_scale", "bias_loc", "bias_scale"}
 
 
 @dataclass(frozen=True)
@@ -52,6 +72,7 @@ class GeneralSettings:
     kernel_width: str = "auto"
     concrete_temperature: float = 0.0
     surrogate: str = "kde"
+    dist_param: float = 0.5
 
 
 _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
@@ -59,9 +80,11 @@ _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
     "acquisition_optimizer": (str,), "obj_transform": (str,), "feasible_fraction": (int, float),
     "random_seed": (int,), "max_rejection_draws": (int,), "softness": (int, float),
     "feas_approach": (str,), "feas_param": (int, float), "auto_desc_gen": (bool,),
-    "kernel_width": (str,), "concrete_temperature": (int, float), "surrogate": (str,),
+    "kernel_width": (str,), "concrete_temperature": (int, float), "surrogate": (str,), "dist_param": (int, float),
 }
-_GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"}, "obj_transform": {"sqrt", "identity"},
+# obj_transform: Gryffin's None (no transform) is our `identity`
+_GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"},
+                    "obj_transform": {"sqrt", "cbrt", "square", "identity"},
                     "feas_approach": {"fwa", "fia", "fca"}, "kernel_width": {"auto", "spacing", "gryffin"},
                     "surrogate": {"kde", "gp", "auto"}}
 
@@ -111,11 +134,17 @@ def _general(spec: Any) -> GeneralSettings:
     values: dict[str, Any] = {}
     for key, value in spec.items():
         if key in GRYFFIN_NO_OP_KEYS:
+            # a database the user asked for deserves a warning; defaults and knobs of the BNN only a note
+            level = logging.WARNING if key == "save_database" and value not in (False, None, "False") else logging.INFO
+            note_no_effect(f"general.{key}", GRYFFIN_NO_OP_KEYS[key], level)
             continue
         if key not in _GENERAL_TYPES:
-            raise ConfigError(f"unknown key 'general.{key}'; known keys: {sorted(_GENERAL_TYPES)}")
+            raise ConfigError(f"unknown key 'general.{key}'; known keys: "
+                              f"{sorted(set(_GENERAL_TYPES) | set(GRYFFIN_NO_OP_KEYS))}")
         if value is None and key in ("feasible_fraction", "random_seed"):
             continue
+        if value is None and key == "obj_transform":
+            value = "identity"
         if isinstance(value, bool) != (_GENERAL_TYPES[key] == (bool,)) or not isinstance(value, _GENERAL_TYPES[key]):
             raise ConfigError(f"'general.{key}' has the wrong type: {value!r}")
         if key in _GENERAL_CHOICES and value not in _GENERAL_CHOICES[key]:
@@ -132,10 +161,26 @@ def _general(spec: Any) -> GeneralSettings:
                           f"{values['concrete_temperature']}")
     if "feas_param" in values and not (values["feas_param"] >= 0 and math.isfinite(values["feas_param"])):
         raise ConfigError(f"'general.feas_param' must be a non-negative number, got {values['feas_param']}")
+    if "dist_param" in values and not (values["dist_param"] >= 0 and math.isfinite(values["dist_param"])):
+        raise ConfigError(f"'general.dist_param' must be a non-negative number, got {values['dist_param']}")
     fraction = values.get("feasible_fraction")
     if fraction is not None and not (0 < fraction <= 1 and math.isfinite(fraction)):
         raise ConfigError(f"'general.feasible_fraction' must be in (0, 1], got {fraction}")
     return GeneralSettings(**values)
+
+
+def _gryffin_section(section: str, spec: Any, keys: set[str], why: str) -> None:
+    """Gryffin 1.0's `database` or `model` section: every key it knows is accepted (and noted once as having no effect
+    here), any other is an error naming it."""
+    if spec is None:
+        return
+    if not isinstance(spec, Mapping):
+        raise ConfigError(f"'{section}' must be a mapping")
+    unknown = set(spec) - keys
+    if unknown:
+        raise ConfigError(f"unknown key(s) {sorted(f'{section}.{k}' for k in unknown)}; known keys: {sorted(keys)}")
+    for key in spec:
+        note_no_effect(f"{section}.{key}", why)
 
 
 def _objectives(spec: Any, parameter_names: tuple[str, ...]) -> list[Objective]:
@@ -197,6 +242,8 @@ def load_config(source: Mapping | str | Path, base_dir: str | Path | None = None
     space = SearchSpace.from_config(raw["parameters"])
     objectives = _objectives(raw.get("objectives"), space.names)
     general = _general(raw.get("general"))
+    _gryffin_section("database", raw.get("database"), GRYFFIN_DATABASE_KEYS, _NO_DATABASE)
+    _gryffin_section("model", raw.get("model"), GRYFFIN_MODEL_KEYS, _NO_BNN)
     constraints = raw.get("constraints") or []
     if not isinstance(constraints, list):
         raise ConfigError("'constraints' must be a list")

@@ -59,6 +59,18 @@ AUTO_MIN_OBSERVATIONS = 5
 ConstraintArg = Callable[[dict], bool] | Sequence[Callable[[dict], bool]] | None
 
 
+def _identity(f: np.ndarray) -> np.ndarray:
+    return f
+
+
+# general.obj_transform on merits in [0, 1] (0 best), as in Gryffin ("identity" is its None), and each inverse:
+# sqrt and cbrt accentuate the best region (cbrt more so), square de-emphasizes it
+OBJ_TRANSFORMS: dict[str, tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray], np.ndarray]]] = {
+    "sqrt": (np.sqrt, np.square), "cbrt": (np.cbrt, lambda f: f ** 3), "square": (np.square, np.sqrt),
+    "identity": (_identity, _identity),
+}
+
+
 @dataclass
 class Observation:
     """One reported experiment. ``objectives`` maps each objective name to a float, or None for a failed experiment."""
@@ -140,6 +152,7 @@ class BasePlanner:
         self._feasible_fraction: FeasibleFraction | None = None
         self._feasible_set: np.ndarray | None = None
         self._constraint_warnings: list[str] | None = None
+        self._strategies: np.ndarray | None = None  # sampling strategies replacing the config's (recommend)
 
     def _complete(self, params: Mapping[str, Any]) -> dict[str, Any]:
         """The modelled parameters of a point -> all parameters (equality-solved ones computed), in config order."""
@@ -312,7 +325,7 @@ class BasePlanner:
             y = -Y[:, 0] if self.objectives[0].goal == "max" else Y[:, 0]
             span = y.max() - y.min()
             f = (y - y.min()) / span if span > 0 else np.zeros_like(y)
-        return np.sqrt(f) if transform and self.config.general.obj_transform == "sqrt" else f
+        return OBJ_TRANSFORMS[self.config.general.obj_transform][0](f) if transform else f
 
     def best(self) -> Observation | None:
         """The best successful observation so far (None before the first one)."""
@@ -338,15 +351,40 @@ class BasePlanner:
             proposals.append(proposal)
         return proposals
 
-    def recommend(self, observations: Sequence[Mapping[str, Any]] | None = None) -> list[dict[str, Any]]:
-        """Gryffin-compatible and stateless: parameter dicts for the given observations, one per (batch, strategy)."""
+    def with_observations(self, observations: Sequence[Mapping[str, Any]] | None = None, draw: int = 0
+                          ) -> BasePlanner:
+        """A fresh planner of the same config, seed and known constraints that knows exactly `observations` and has
+        nothing pending (the feasible-set estimate is shared, not recomputed). `draw` (>= 0) picks another set of
+        random draws for the same observations: draw k makes the draws of a planner that has been asked k times."""
+        if isinstance(draw, bool) or not isinstance(draw, (int, np.integer)) or draw < 0:
+            raise ValueError(f"draw must be a non-negative integer, got {draw!r}")
         fresh = type(self)(self.config, self._known_constraints, self.seed)
         fresh._feasible_fraction, fresh._feasible_set = self._feasible_fraction, self._feasible_set
         fresh._constraint_warnings = self._constraint_warnings
         if observations:
             fresh.tell(list(observations))
+        fresh._ask_count = int(draw)
+        return fresh
+
+    def recommend(self, observations: Sequence[Mapping[str, Any]] | None = None,
+                  sampling_strategies: Sequence[float] | None = None, num_batches: int | None = None,
+                  draw: int = 0) -> list[dict[str, Any]]:
+        """Gryffin-compatible and stateless: parameter dicts for the given observations, `num_batches` batches
+        (default general.batches) of one proposal per sampling strategy, batch by batch. `sampling_strategies`
+        (values s, +1 exploit, -1 explore) replace the config's for this call; `draw` as in `with_observations`."""
         general = self.config.general
-        return [p.params for p in fresh.ask(general.batches * general.sampling_strategies)]
+        fresh = self.with_observations(observations, draw)
+        count = general.sampling_strategies
+        if sampling_strategies is not None:
+            values = np.atleast_1d(np.asarray(sampling_strategies, dtype=float))
+            if values.ndim != 1 or not len(values) or not np.all(np.isfinite(values)):
+                raise ValueError(f"sampling_strategies must be a non-empty list of finite numbers, got "
+                                 f"{sampling_strategies!r}")
+            fresh._strategies, count = values, len(values)
+        batches = general.batches if num_batches is None else num_batches
+        if isinstance(batches, bool) or not isinstance(batches, (int, np.integer)) or batches < 1:
+            raise ValueError(f"num_batches must be a positive integer, got {num_batches!r}")
+        return [p.params for p in fresh.ask(int(batches) * count)]
 
     def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
         """n internal points, the sampling strategy of each and what every proposal of this ask records in meta."""
@@ -415,6 +453,18 @@ class BasePlanner:
         return planner
 
 
+@dataclass
+class Surrogates:
+    """The models of one ask of the kernel-density Planner (`Planner.surrogates()`)."""
+
+    successful: list[Observation]  # the successful experiments, in order
+    X: np.ndarray  # their points, internal units
+    merits: np.ndarray  # their merits after general.obj_transform (0 best): what the kernels regress
+    descriptors: dict[int, np.ndarray]  # learned descriptor tables by finite dim (general.auto_desc_gen)
+    density: KernelDensity | None  # None before the first successful experiment
+    feasibility: FeasibilityModel | None  # None until an experiment has failed
+
+
 class Planner(BasePlanner):
     """Gryffin with known constraints: kernel-density surrogate, lambda strategies, constrained Adam+Hill or genetic
     acquisition optimization, diversity-aware selection; or (general.surrogate) a Gaussian process under the same
@@ -429,7 +479,10 @@ class Planner(BasePlanner):
             require_botorch()
 
     def strategy_values(self) -> np.ndarray:
-        """Sampling strategies s, from exploitation (+1) to exploration (-1); a single strategy is s = 0."""
+        """Sampling strategies s, from exploitation (+1) to exploration (-1); a single strategy is s = 0 (or those
+        given to `recommend`)."""
+        if self._strategies is not None:
+            return self._strategies.copy()
         count = self.config.general.sampling_strategies
         return np.linspace(1.0, -1.0, count) if count > 1 else np.zeros(1)
 
@@ -512,7 +565,8 @@ class Planner(BasePlanner):
         score = -feasibility.probability(candidates) if len(candidates) else np.empty(0)
         points = []
         for _ in range(n):
-            index = select(self.space, candidates, score, observed, chosen) if len(candidates) else None
+            index = (select(self.space, candidates, score, observed, chosen, dist_param=self.config.general.dist_param)
+                     if len(candidates) else None)
             x = candidates[index] if index is not None else self.random_points(
                 1, rng, np.concatenate([observed, chosen]))[0]
             chosen = np.concatenate([chosen, x[None]])
@@ -569,22 +623,39 @@ class Planner(BasePlanner):
         chosen = "gp" if z["gp"] - z["kde"] > math.sqrt(1.06 / (levels - 3)) else "kde"
         return (gp if chosen == "gp" else None), {"surrogate": chosen, "loo_rank_correlation": scores}
 
-    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
-        observed = self.observed_points()
-        chosen = self.pending_points()
+    def _surrogates(self, generator: torch.Generator) -> Surrogates:
+        """The failure model, then (with a successful experiment) the kernel density of the merits, in that order of
+        draws from `generator`."""
         successful = [o for o in self.observations if not o.failed]
-        generator = torch.Generator().manual_seed(int(rng.integers(2**63)))
-        feasibility = self._feasibility(observed, generator)
+        feasibility = self._feasibility(self.observed_points(), generator)
         if not successful:
-            if feasibility is None:
-                return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n, {}
-            return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n, {}
+            return Surrogates(successful, np.empty((0, self.space.dim)), np.empty(0), {}, None, feasibility)
         X = self._internal([o.params for o in successful])
         merits = self.merits(successful)
         descriptors = {d: r.table for d, r in self.learned_descriptors(X, merits).items()}
         density = KernelDensity(self.space, X, merits, self.feasible_fraction.value, generator,
                                 spacing_scaled=self.spacing_kernels, spacing_factor=SPACING_FACTOR,
                                 descriptors=descriptors, temperature_scale=self.config.general.concrete_temperature)
+        return Surrogates(successful, X, merits, descriptors, density, feasibility)
+
+    def surrogates(self) -> Surrogates:
+        """The kernel density and the failure model that the next ask() builds, with the same draws (for
+        inspection: regression, P(feasible), acquisition; the GP of general.surrogate is not among them)."""
+        rng = self._rng()
+        return self._surrogates(torch.Generator().manual_seed(int(rng.integers(2**63))))
+
+    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
+        observed = self.observed_points()
+        chosen = self.pending_points()
+        generator = torch.Generator().manual_seed(int(rng.integers(2**63)))
+        models = self._surrogates(generator)
+        successful = models.successful
+        feasibility = models.feasibility
+        if models.density is None:
+            if feasibility is None:
+                return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n, {}
+            return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n, {}
+        X, merits, descriptors, density = models.X, models.merits, models.descriptors, models.density
         gp, meta = self._choose_surrogate(X, merits, successful, density, descriptors)
         start, exhaustive = self._start_points(rng, X[int(np.argmin(merits))], X)
         if gp is not None:
@@ -600,7 +671,8 @@ class Planner(BasePlanner):
                 refined[s] = self._candidates(Acquisition(density, s), start, exhaustive, optimizer, rng,
                                               feasibility)
             candidates, alpha = refined[s]
-            index = select(self.space, candidates, alpha, observed, chosen) if len(candidates) else None
+            index = (select(self.space, candidates, alpha, observed, chosen, dist_param=self.config.general.dist_param)
+                     if len(candidates) else None)
             x = candidates[index] if index is not None else self.random_points(
                 1, rng, np.concatenate([observed, chosen]))[0]
             chosen = np.concatenate([chosen, x[None]])

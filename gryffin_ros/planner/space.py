@@ -7,6 +7,7 @@ index of their option (stored as a float so one array holds a mixed point).
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -16,6 +17,7 @@ import numpy as np
 
 from .errors import ConfigError, ObservationError
 from .literals import suggestion
+from .notices import note_no_effect
 
 
 @dataclass(frozen=True)
@@ -56,7 +58,8 @@ class CategoricalParameter:
 
 Parameter = ContinuousParameter | DiscreteParameter | CategoricalParameter
 
-_COMMON_KEYS = {"name", "type"}
+# size and process_constrained: Gryffin 1.0 keys, accepted (see parameter_from_spec)
+_COMMON_KEYS = {"name", "type", "size", "process_constrained"}
 _ALLOWED_KEYS = {
     "continuous": _COMMON_KEYS | {"low", "high", "periodic", "size"},
     "discrete": _COMMON_KEYS | {"low", "high", "options", "size"},
@@ -79,8 +82,8 @@ def _rescale_descriptors(name: str, options: Sequence[str], table: Mapping) -> n
         raise ConfigError(f"parameter '{name}': descriptors given for {unknown[0]!r}, which is not one of its options "
                           f"({', '.join(repr(o) for o in options)}){suggestion(unknown[0], list(options))}")
     rows = [table.get(option) for option in options]
-    if all(row is None for row in rows):
-        return None
+    if all(row is None or (isinstance(row, (list, tuple)) and not row) for row in rows):
+        return None  # no descriptors (Gryffin 1.0 writes them as empty lists)
     if any(row is None for row in rows):
         missing = [o for o, row in zip(options, rows) if row is None]
         raise ConfigError(f"parameter '{name}': descriptors missing for options {missing}")
@@ -111,8 +114,15 @@ def parameter_from_spec(spec: Mapping[str, Any], position: int) -> Parameter:
     unknown = set(spec) - _ALLOWED_KEYS[kind]
     if unknown:
         raise ConfigError(f"{where}: unknown key(s) {sorted(unknown)} for a {kind} parameter")
-    if spec.get("size", 1) != 1:
-        raise ConfigError(f"{where}: 'size' other than 1 is not supported; list each dimension as its own parameter")
+    size = spec.get("size", 1)
+    if isinstance(size, bool) or not isinstance(size, int) or size < 1:
+        raise ConfigError(f"{where}: 'size' must be a positive integer, got {size!r}")
+    if size != 1:  # Phoenics' vector parameters; Gryffin 1.0 reads one value per parameter name and ignores `size`
+        note_no_effect(f"parameters.{name}.size", f"'{name}' is one dimension, as in Gryffin 1.0, which ignores "
+                       "'size'; list each dimension as its own parameter", logging.WARNING)
+    if spec.get("process_constrained", False) not in (False, 0, None):
+        note_no_effect(f"parameters.{name}.process_constrained", "Gryffin's process constraint is not implemented: the "
+                       f"proposals of one recommendation do not share the value of '{name}'", logging.WARNING)
 
     if kind == "continuous":
         low, high = _number(spec, "low", where), _number(spec, "high", where)
