@@ -16,18 +16,20 @@ def test_schema_examples_validate(name):
         messages.check(name, example)
 
 
+# What the reason must say: ours (where, and the field concerned), not jsonschema's wording around the field's name,
+# which is a third-party library's and may change with its version.
 @pytest.mark.parametrize("text, reason", [
-    ("[1, 2", "malformed JSON"),
-    ('{"experiment_id": "a", "params": {"x": NaN}, "objectives": null}', "NaN is not valid JSON"),
-    ('{"experiment_id": "a", "params": {"x": 1}}', "'objectives' is a required property"),
-    ('{"experiment_id": "a", "params": {"x": [1]}, "objectives": null}', "invalid at params/x"),
-    ('{"experiment_id": "a", "params": {"x": 1}, "objectives": null, "extra": 1}', "'extra' was unexpected"),
-    ("[]", "invalid"),
+    ("[1, 2", ["malformed JSON"]),
+    ('{"experiment_id": "a", "params": {"x": NaN}, "objectives": null}', ["NaN is not valid JSON"]),
+    ('{"experiment_id": "a", "params": {"x": 1}}', ["invalid at (root)", "'objectives'"]),
+    ('{"experiment_id": "a", "params": {"x": [1]}, "objectives": null}', ["invalid at params/x"]),
+    ('{"experiment_id": "a", "params": {"x": 1}, "objectives": null, "extra": 1}', ["invalid at (root)", "'extra'"]),
+    ("[]", ["invalid"]),
 ])
 def test_bad_observation_payloads_are_refused_with_a_reason(text, reason):
     with pytest.raises(messages.MessageError) as info:
         messages.parse("observation", text)
-    assert reason in str(info.value)
+    assert all(part in str(info.value) for part in reason), str(info.value)
 
 
 def test_oversized_message_is_refused_before_parsing():

@@ -31,6 +31,10 @@ from std_srvs.srv import Trigger  # noqa: E402
 from gryffin_ros.nodes.qos import EVENTS_QOS, LATCHED_QOS, OBSERVATIONS_QOS  # noqa: E402
 
 PLUGIN_PATH = Path(__file__).resolve().parents[1] / "plugin_package"
+# Deadlines only catch hangs. Each is many times what its step takes on a busy 2-core machine (a node starts in
+# about 5 s there, an ask takes about a second, discovery and an answer well under one), so a slow machine waits
+# longer but never fails a test that a fast one passes; a passing test never waits for a deadline.
+HANG_S = 180.0
 FLOW_CONFIG = {
     "name": "flow_test",
     "parameters": [{"name": "F_C", "type": "continuous", "low": 0.0, "high": 200.0},
@@ -67,7 +71,7 @@ class Client(Node):
                 sink.append(json.loads(msg.data))
         return callback
 
-    def call(self, client, timeout: float = 30.0) -> Trigger.Response:
+    def call(self, client, timeout: float = HANG_S) -> Trigger.Response:
         assert client.wait_for_service(timeout_sec=timeout), f"service {client.srv_name} not available"
         future = client.call_async(Trigger.Request())
         deadline = time.monotonic() + timeout
@@ -82,7 +86,7 @@ class Client(Node):
     def recommend(self) -> Trigger.Response:
         return self.call(self.recommend_client)
 
-    def wait_matched(self, timeout: float = 10.0) -> None:
+    def wait_matched(self, timeout: float = HANG_S) -> None:
         deadline = time.monotonic() + timeout
         while self.publisher.get_subscription_count() == 0:
             assert time.monotonic() < deadline, "planner's observation subscription never matched"
@@ -91,7 +95,7 @@ class Client(Node):
     def publish(self, payload) -> None:
         self.publisher.publish(String(data=payload if isinstance(payload, str) else json.dumps(payload)))
 
-    def wait_events(self, count: int, timeout: float = 15.0) -> list[dict]:
+    def wait_events(self, count: int, timeout: float = HANG_S) -> list[dict]:
         deadline = time.monotonic() + timeout
         while True:
             with self.lock:
@@ -101,7 +105,7 @@ class Client(Node):
             assert time.monotonic() < deadline, f"expected {count} observation events, got {observed}"
             time.sleep(0.02)
 
-    def wait_proposals(self, count: int, timeout: float = 30.0) -> list[dict]:
+    def wait_proposals(self, count: int, timeout: float = HANG_S) -> list[dict]:
         deadline = time.monotonic() + timeout
         while True:
             with self.lock:
@@ -164,7 +168,7 @@ class PlannerProcess:
         if self.process.poll() is None:
             self.process.send_signal(signal.SIGINT)
             try:
-                self.process.wait(timeout=15)
+                self.process.wait(timeout=HANG_S)  # a node finishes an ask in flight before it exits
             except subprocess.TimeoutExpired:
                 self.process.kill()
                 self.process.wait()
@@ -183,7 +187,7 @@ def start_planner(tmp_path, lab_session):
             seen = len(lab_session.statuses)
         process = PlannerProcess(tmp_path, config, **params)
         started.append(process)
-        deadline = time.monotonic() + 60
+        deadline = time.monotonic() + HANG_S
         while wait:
             with lab_session.lock:
                 if len(lab_session.statuses) > seen and "campaign '" in process.output():

@@ -9,7 +9,9 @@ import sys
 import time
 from pathlib import Path
 
-from .conftest import node_env
+from tests import fastdds_shm
+
+from .conftest import HANG_S, node_env
 
 BUDGET = 24
 KILLS = 5
@@ -22,7 +24,19 @@ def stored(path: Path) -> tuple[list[str], list[str]]:
     return observed, proposed
 
 
+def wait_for_observations(path: Path, count: int) -> None:
+    """Until the store holds `count` observations; fails only when none is added for HANG_S (a stalled campaign)."""
+    seen, deadline = -1, 0.0
+    while (n := len(stored(path)[0])) < count:
+        if n != seen:
+            seen, deadline = n, time.monotonic() + HANG_S
+        assert time.monotonic() < deadline, f"campaign stalled at {n} observations"
+        time.sleep(0.2)
+
+
 def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, start_planner, tmp_path):
+    fastdds_shm.clean()  # what crashed runs left before this test is not this test's business
+    before = fastdds_shm.lock_files()
     store = tmp_path / "crash.sqlite"
     emulator = subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.emulator_node", "flow_reactor", "--ros-args",
                                  "-p", "seed:=3", "-p", "experiment_time_s:=0.05", "-p", "objectives:=[X1_X2]"],
@@ -33,16 +47,16 @@ def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, 
     try:
         planner = start_planner(storage=str(store), batch_size=2, seed=5)
         for _ in range(KILLS):
-            time.sleep(rng.uniform(0.3, 1.5))
+            # a random moment of the campaign, counted in its progress (0-2 more stored observations, then up to a
+            # second more), not in seconds: on a slow machine seconds alone would land every kill in the first ask
+            wait_for_observations(store, len(stored(store)[0]) + rng.randint(0, 2))
+            time.sleep(rng.uniform(0.0, 1.0))
             planner.process.kill()  # SIGKILL: no shutdown code runs
             planner.process.wait()
             with client.lock:
                 acknowledged |= {e["experiment_id"] for e in client.events if e["type"] == "observation_accepted"}
             planner = start_planner(storage=str(store), batch_size=2, seed=5)
-        deadline = time.monotonic() + 120
-        while len(stored(store)[0]) < BUDGET:
-            assert time.monotonic() < deadline, f"campaign stalled at {len(stored(store)[0])} observations"
-            time.sleep(0.2)
+        wait_for_observations(store, BUDGET)
         with client.lock:
             acknowledged |= {e["experiment_id"] for e in client.events if e["type"] == "observation_accepted"}
     finally:
@@ -55,7 +69,5 @@ def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, 
     assert len(proposed) == len(set(proposed))
     status = client.status()
     assert status["n_observations"] >= BUDGET
-    tool = Path(sys.executable).with_name("fastdds")
-    subprocess.run([str(tool), "shm", "clean"], capture_output=True, timeout=60)  # the killed nodes' segments
-    again = subprocess.run([str(tool), "shm", "clean"], capture_output=True, text=True, timeout=60).stdout
-    assert "0 zombie segments cleaned" in again
+    fastdds_shm.clean()  # the killed nodes' ports and segments
+    assert not fastdds_shm.zombies(fastdds_shm.lock_files() - before), "shared memory of dead nodes left behind"

@@ -5,6 +5,7 @@ valid observations."""
 import json
 import sqlite3
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -43,41 +44,40 @@ def adversarial(proposal: dict, used: str) -> tuple[st.SearchStrategy, tuple[str
     return bad, (json.dumps(obs()), True)
 
 
+@pytest.fixture
+def fuzz_store(client, start_planner, tmp_path):
+    """One planner node for all examples of a run (hypothesis sets up function-scoped fixtures once per test, not once
+    per example); its store."""
+    store = tmp_path / "fuzz.sqlite"
+    start_planner(auto_propose=False, storage=str(store))
+    client.wait_matched()
+    return store
+
+
+def stored_ids(store) -> list[str]:
+    with sqlite3.connect(store) as db:
+        return [r[0] for r in db.execute("SELECT experiment_id FROM observations ORDER BY seq")]
+
 
 @settings(max_examples=60, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture,
                                  HealthCheck.data_too_large])
 @given(data=st.data())
-def test_fuzzed_observations(client, start_planner, tmp_path, data):
-    """Each example: one drawn adversarial payload (must be rejected), then a valid observation (must be accepted)."""
-    state = fuzz_state(client, start_planner, tmp_path)
-    proposal = state["fresh"][0]
-    bad, (good, _) = adversarial(proposal, state["used"])
+def test_fuzzed_observations(client, fuzz_store, data):
+    """Each example: one drawn adversarial payload (must be rejected), then a valid observation (must be accepted).
+    An example takes what it needs from the node and its store, not from earlier examples, and checks only what it
+    changed, so a replayed or shrunk example means the same as in the run that found it."""
+    (proposal,) = json.loads(client.recommend().message)["proposals"]  # the node keeps serving
+    stored_before = stored_ids(fuzz_store)
+    used = stored_before[-1] if stored_before else "no-such-id"  # an already reported experiment_id
+    bad, (good, _) = adversarial(proposal, used)
     text, _ = data.draw(bad)
+    observations_before = client.status()["n_observations"]
     before = len(client.wait_events(0))
     client.publish(text)
     client.publish(good)
     rejected, accepted = client.wait_events(before + 2)[before:]
     assert rejected["type"] == "observation_rejected" and rejected["reason"], (text[:200], rejected)
     assert accepted == {"type": "observation_accepted", "experiment_id": proposal["experiment_id"]}
-    state["accepted"].append(state["fresh"].pop(0)["experiment_id"])
-    state["used"] = proposal["experiment_id"]
-    if not state["fresh"]:
-        state["fresh"] = [json.loads(client.recommend().message)["proposals"][0] for _ in range(5)]
-    assert client.status()["n_observations"] == len(state["accepted"])
-    with sqlite3.connect(state["store"]) as db:
-        assert [r[0] for r in db.execute("SELECT experiment_id FROM observations ORDER BY seq")] == state["accepted"]
-
-
-FUZZ: dict = {}
-
-
-def fuzz_state(client, start_planner, tmp_path) -> dict:
-    """One planner node for all examples (hypothesis reuses the function-scoped fixtures of the first one)."""
-    if not FUZZ:
-        store = tmp_path / "fuzz.sqlite"
-        start_planner(auto_propose=False, storage=str(store))
-        client.wait_matched()
-        fresh = [json.loads(client.recommend().message)["proposals"][0] for _ in range(5)]
-        FUZZ.update(store=store, fresh=fresh, accepted=[], used="no-such-id")
-    return FUZZ
+    assert client.status()["n_observations"] == observations_before + 1
+    assert stored_ids(fuzz_store) == [*stored_before, proposal["experiment_id"]]

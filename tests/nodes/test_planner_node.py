@@ -8,7 +8,7 @@ import time
 
 from gryffin_ros import messages
 
-from .conftest import FLOW_CONFIG, flow_feasible, node_env
+from .conftest import FLOW_CONFIG, HANG_S, flow_feasible, node_env
 
 
 def observation(proposal, value=0.5, **changes):
@@ -83,19 +83,20 @@ def test_restart_on_the_same_store_resumes_and_refuses_another_config(client, st
     client.wait_events(start + 3)
     assert planner.stop() == 0
     start_planner(auto_propose=False)
-    deadline = time.monotonic() + 30
+    deadline = time.monotonic() + HANG_S
     while True:  # the old node's service may still be discovered for a moment
         status = client.status()
         if status["n_pending"] == 1 or time.monotonic() > deadline:
             break
         time.sleep(0.1)
     assert (status["n_observations"], status["n_pending"]) == (3, 1)
+    client.wait_matched()  # the new node's subscription: a message sent before it matches is lost (volatile QoS)
     client.publish(observation(proposals[3], value=0.8))
     client.wait_events(start + 4)
     assert client.status()["best"]["objectives"] == {"X1_X2": 0.8}
     other = {**FLOW_CONFIG, "constraints": ["F_C + F_S <= 100"]}
     refused = start_planner(other, wait=False, auto_propose=False)
-    assert refused.process.wait(timeout=60) == 2
+    assert refused.process.wait(timeout=HANG_S) == 2
     assert "different config" in refused.output()
 
 
@@ -121,13 +122,13 @@ def test_third_party_plugin_loads_and_a_raising_plugin_is_reported(client, start
         assert proposal["params"]["F_C"] + proposal["params"]["F_S"] <= 60
     planner = start_planner({**FLOW_CONFIG, "name": "exploding", "constraints": [{"plugin": "test_exploding"}]},
                             wait=False, auto_propose=False, storage="\":memory:\"")
-    assert planner.process.wait(timeout=60) == 2  # V_C is estimated at start-up: the broken plugin stops it there
+    assert planner.process.wait(timeout=HANG_S) == 2  # V_C is estimated at start-up: the broken plugin stops it there
     assert "'test_exploding' raised RuntimeError: interlock controller unreachable" in planner.output()
 
 
 def test_the_config_chooses_the_optimizer_unless_the_node_parameter_overrides_it(client, start_planner, tmp_path):
     def logged(node, text: str) -> bool:  # the start-up line may follow the first status by a moment
-        deadline = time.monotonic() + 10
+        deadline = time.monotonic() + HANG_S
         while text not in node.output() and time.monotonic() < deadline:
             time.sleep(0.05)
         return text in node.output()
@@ -143,19 +144,19 @@ def test_the_config_chooses_the_optimizer_unless_the_node_parameter_overrides_it
 def test_bad_start_up_parameters_exit_with_a_message(tmp_path):
     env = node_env(tmp_path)
     result = subprocess.run([sys.executable, "-m", "gryffin_ros.nodes.planner_node"], env=env, capture_output=True,
-                            text=True, timeout=60)
+                            text=True, timeout=HANG_S)
     assert result.returncode == 2 and "parameter 'config' is required" in result.stderr
     config = tmp_path / "contradiction.json"
     config.write_text(json.dumps({**FLOW_CONFIG, "constraints": ["F_C < 10", "F_C > 20"]}))
     result = subprocess.run([sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-p",
                              f"config:={config}", "-p", "storage:=\":memory:\""], env=env, capture_output=True,
-                            text=True, timeout=60)
+                            text=True, timeout=HANG_S)
     assert result.returncode == 2 and "no point satisfying the known constraints" in result.stderr
     config.write_text(json.dumps({**FLOW_CONFIG, "parameters": [*FLOW_CONFIG["parameters"], SOLVENT],
                                   "constraints": ["T < 66 if solvent == 'thf' else T < 150"]}))
     result = subprocess.run([sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-p",
                              f"config:={config}", "-p", "storage:=\":memory:\""], env=env, capture_output=True,
-                            text=True, timeout=60)
+                            text=True, timeout=HANG_S)
     assert result.returncode == 2 and "'thf' is not an option of 'solvent'" in result.stderr
     assert "did you mean 'THF'?" in result.stderr
 
