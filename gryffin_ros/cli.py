@@ -13,12 +13,13 @@ from pathlib import Path
 
 import numpy as np
 
+from .campaign import Campaign
 from .emulators import FlowReactorEmulator, RedoxEmulator
 from .paths import share_path
 from .planner import GryffinRosError, Planner
 from .planner.config import PlannerConfig, load_config
 from .rosenv import ros_environment
-from .storage import CampaignStore
+from .storage import CampaignStore, StoreError
 
 STALL_SECONDS = 120.0
 
@@ -79,22 +80,20 @@ def emulator_settings(config: PlannerConfig) -> tuple[str, list[str], list[str]]
     return kind, names, objectives
 
 
-def run_local(config: PlannerConfig, store: CampaignStore, args: argparse.Namespace, progress: Progress,
-              seed: int | None) -> None:
-    """The same campaign through the Python API: planner and emulator in this process, same store."""
+def run_local(config_path: str, config: PlannerConfig, store_path: Path, args: argparse.Namespace,
+              progress: Progress, seed: int | None) -> None:
+    """The same campaign through the Python API: a Campaign and the emulator in this process, same store."""
     kind, names, objectives = emulator_settings(config)
     emulator = (RedoxEmulator(noise=args.noise, seed=seed) if kind == "redox"
                 else FlowReactorEmulator(seed=seed, parameters=tuple(names)))
-    planner = Planner(config, seed=seed)
-    planner.tell(store.observations())
-    while len(planner.observations) < args.budget:
-        for proposal in planner.ask():
-            result = emulator.measure(proposal.params)
-            observation = planner.tell({"experiment_id": proposal.experiment_id, "params": proposal.params,
-                                        "objectives": {k: result[k] for k in objectives}, "meta": result})[0]
-            store.add_observation(observation)
-            best = planner.best()
-            progress.show(len(planner.observations), best.objectives if best else None)
+    with Campaign(config_path, store_path, seed=seed) as campaign:
+        while campaign.n_observations < args.budget:
+            for proposal in campaign.pending or campaign.propose():
+                result = emulator.measure(proposal.params)
+                campaign.observe({"experiment_id": proposal.experiment_id, "params": proposal.params,
+                                  "objectives": {k: result[k] for k in objectives}, "meta": result})
+                best = campaign.best
+                progress.show(campaign.n_observations, best.objectives if best else None)
 
 
 def stop(processes: list[subprocess.Popen], env: dict[str, str]) -> None:
@@ -118,15 +117,16 @@ def stop(processes: list[subprocess.Popen], env: dict[str, str]) -> None:
         subprocess.run([str(fastdds), "shm", "clean"], env=env, capture_output=True, timeout=30)
 
 
-def run_ros(config_path: str, config: PlannerConfig, store: CampaignStore, args: argparse.Namespace,
+def run_ros(config_path: str, config: PlannerConfig, store_path: Path, args: argparse.Namespace,
             progress: Progress, out: Path, seed: int | None) -> None:
-    """Planner node and emulator node as separate processes over DDS on loopback; progress read from the store."""
+    """Planner node and emulator node as separate processes over DDS on loopback; progress read from the store
+    (read-only: the planner node holds it)."""
     kind, names, objectives = emulator_settings(config)
     env = ros_environment(domain_id=args.domain_id)
     env["ROS_LOG_DIR"] = str(out / "ros_logs")
     seed = -1 if seed is None else seed
     planner_cmd = [sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args",
-                   "-p", f"config:={config_path}", "-p", f"storage:={store.path}", "-p", f"seed:={seed}"]
+                   "-p", f"config:={config_path}", "-p", f"storage:={store_path}", "-p", f"seed:={seed}"]
     emulator_cmd = [sys.executable, "-m", "gryffin_ros.nodes.emulator_node", kind, "--ros-args",
                     "-p", f"seed:={seed}", "-p", f"experiment_time_s:={args.experiment_time}",
                     "-p", f"objectives:=[{','.join(objectives)}]"]
@@ -136,10 +136,16 @@ def run_ros(config_path: str, config: PlannerConfig, store: CampaignStore, args:
     processes = [subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT)
                  for cmd, log in zip((planner_cmd, emulator_cmd), logs)]
     best_value = BestSoFar(config)
+    store = None
     try:
         done, last_change = -1, time.monotonic()
         while True:
-            count, best = best_value(store)
+            if store is None and store_path.is_file():
+                try:
+                    store = CampaignStore.open_existing(store_path)
+                except StoreError:  # the node is still creating it
+                    store = None
+            count, best = best_value(store) if store is not None else (0, None)
             progress.show(count, best)
             if count >= args.budget:
                 return
@@ -156,6 +162,8 @@ def run_ros(config_path: str, config: PlannerConfig, store: CampaignStore, args:
         stop(processes, env)
         for log in logs:
             log.close()
+        if store is not None:
+            store.close()
 
 
 def plot(store: CampaignStore, config: PlannerConfig, path: Path) -> None:
@@ -188,18 +196,20 @@ def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespa
                  seed: int | None) -> tuple[int, dict[str, float] | None, bool]:
     """One campaign into `out`: store, CSV, PNG. Returns (experiments, best objectives, interrupted)."""
     out.mkdir(parents=True, exist_ok=True)
-    store = CampaignStore(out / "campaign.sqlite", config.raw, config.hash)
+    store_path = out / "campaign.sqlite"
+    CampaignStore(store_path, config.raw, config.hash).close()  # created (or checked) before anything starts
     progress = Progress(args.budget)
     interrupted = False
     try:
         if args.no_ros:
-            run_local(config, store, args, progress, seed)
+            run_local(config_path, config, store_path, args, progress, seed)
         else:
-            run_ros(config_path, config, store, args, progress, out, seed)
+            run_ros(config_path, config, store_path, args, progress, out, seed)
     except KeyboardInterrupt:
         interrupted = True
     finally:
         progress.close()
+        store = CampaignStore.open_existing(store_path)
         rows = store.export_csv(out / "experiments.csv")
         if rows:
             plot(store, config, out / "best_so_far.png")

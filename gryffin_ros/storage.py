@@ -2,13 +2,18 @@
 (with the raw message it came in). The only module that touches the database.
 
 An observation is committed before this module returns, so a caller that acknowledges after ``add_observation`` never
-acknowledges something a crash could lose.
+acknowledges something a crash could lose. One process writes a store at a time: a writer holds an exclusive lock
+on ``<store>.lock`` (released by the operating system when the process ends, however it ends); readers
+(``open_existing``: export, progress, dashboards) take no lock.
 """
 
 from __future__ import annotations
 
 import csv
+import fcntl
 import json
+import os
+import socket
 import sqlite3
 import threading
 import time
@@ -34,10 +39,49 @@ class StoreError(GryffinRosError):
     """The campaign store cannot be used (another campaign's file, unreadable, duplicate experiment)."""
 
 
+def _hold(path: str):
+    """Take the exclusive writer's lock of the store at `path` (a file beside it naming the holder), or raise
+    StoreError naming the process that holds it."""
+    lock_path = f"{path}.lock"
+    try:
+        handle = open(lock_path, "a+")
+    except OSError as exc:
+        raise StoreError(f"cannot create the lock file '{lock_path}' of campaign store '{path}': {exc.strerror}") \
+            from None
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        handle.seek(0)
+        holder = handle.read().strip() or "another process"
+        handle.close()
+        raise StoreError(f"campaign store '{path}' is in use by {holder}; a store has one writer at a time: stop "
+                         "that process first, or give this one another storage file") from None
+    handle.seek(0)
+    handle.truncate()
+    handle.write(f"pid {os.getpid()} on {socket.gethostname()} since {time.strftime('%Y-%m-%d %H:%M:%S')}\n")
+    handle.flush()
+    return handle
+
+
 class CampaignStore:
-    def __init__(self, path: str | Path, config: dict, config_hash: str):
+    """A campaign's SQLite file. Opened with a config (the writer: holds the store exclusively, creates it when new,
+    refuses another config's store) or by ``open_existing`` (read-only, no lock)."""
+
+    def __init__(self, path: str | Path, config: dict, config_hash: str, *, readonly: bool = False):
         self.path = str(path)
+        self.readonly = readonly
         self._lock = threading.Lock()
+        self._holder = None
+        if readonly:
+            try:
+                self._db = sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, check_same_thread=False,
+                                           isolation_level=None, timeout=30.0)
+                self._db.execute("SELECT COUNT(*) FROM observations")
+            except sqlite3.DatabaseError as exc:
+                raise StoreError(f"'{self.path}' is not a campaign store: {exc}") from None
+            return
+        if self.path != ":memory:":
+            self._holder = _hold(self.path)
         try:
             self._db = sqlite3.connect(self.path, check_same_thread=False, isolation_level=None, timeout=30.0)
             if self.path != ":memory:":
@@ -48,6 +92,7 @@ class CampaignStore:
             if "meta" not in columns:  # a store written before proposals recorded how they were chosen
                 self._db.execute("ALTER TABLE proposals ADD COLUMN meta TEXT")
         except sqlite3.DatabaseError as exc:
+            self._release()
             raise StoreError(f"cannot open campaign store '{self.path}': {exc}") from None
         stored = self.get_meta("config_hash")
         if stored is None:
@@ -56,13 +101,14 @@ class CampaignStore:
                 self._set_meta("config_hash", config_hash)
                 self._set_meta("created", repr(time.time()))
         elif stored != config_hash:
+            self.close()
             raise StoreError(
                 f"campaign store '{self.path}' belongs to a different config (stored hash {stored[:12]}, this config "
                 f"{config_hash[:12]}); use another storage file, or the config it was started with")
 
     @classmethod
     def open_existing(cls, path: str | Path) -> CampaignStore:
-        """Open a store written earlier, with the config it holds."""
+        """Open a store written earlier (or being written by a running campaign) for reading, without a lock."""
         if not Path(path).is_file():
             raise StoreError(f"no campaign store at '{path}'")
         try:
@@ -72,11 +118,18 @@ class CampaignStore:
             raise StoreError(f"'{path}' is not a campaign store: {exc}") from None
         if set(rows) != {"config", "config_hash"}:
             raise StoreError(f"'{path}' is not a campaign store (no config recorded)")
-        return cls(path, json.loads(rows["config"]), rows["config_hash"])
+        return cls(path, json.loads(rows["config"]), rows["config_hash"], readonly=True)
+
+    @property
+    def config(self) -> dict:
+        """The config the store was created with."""
+        return json.loads(self.get_meta("config") or "{}")
 
     # ---- low level -------------------------------------------------------------------------------------------
     @contextmanager
     def _transaction(self) -> Iterator[None]:
+        if self.readonly:
+            raise StoreError(f"campaign store '{self.path}' is open for reading only")
         with self._lock:
             self._db.execute("BEGIN IMMEDIATE")
             try:
@@ -104,6 +157,13 @@ class CampaignStore:
     def close(self) -> None:
         with self._lock:
             self._db.close()
+        self._release()
+
+    def _release(self) -> None:
+        if self._holder is not None:
+            fcntl.flock(self._holder, fcntl.LOCK_UN)
+            self._holder.close()
+            self._holder = None
 
     # ---- campaign data ---------------------------------------------------------------------------------------
     def add_proposals(self, proposals: Iterable[Proposal], meta: dict[str, str] | None = None) -> None:
@@ -141,8 +201,15 @@ class CampaignStore:
 
     def pending(self) -> list[Proposal]:
         """Proposals without an observation yet, oldest first."""
-        reported = {o.experiment_id for o in self.observations()}
-        return [p for p in self.proposals() if p.experiment_id not in reported]
+        rows = self._query("SELECT experiment_id, params, strategy, meta FROM proposals WHERE experiment_id NOT IN "
+                           "(SELECT experiment_id FROM observations) ORDER BY created, rowid")
+        return [Proposal(eid, json.loads(params), strategy, json.loads(meta) if meta else {})
+                for eid, params, strategy, meta in rows]
+
+    def raw(self, experiment_id: str) -> str | None:
+        """The message an observation arrived in, as it arrived (None when it came through the Python API)."""
+        rows = self._query("SELECT raw FROM observations WHERE experiment_id = ?", (experiment_id,))
+        return rows[0][0] if rows else None
 
     def count_observations(self) -> int:
         return self._query("SELECT COUNT(*) FROM observations")[0][0]

@@ -17,13 +17,27 @@ def test_observations_survive_reopening_in_order(tmp_path):
     store.add_proposals([Proposal("a", {"x": 0.1}, 1.0), Proposal("b", {"x": 0.2}, -1.0), Proposal("c", {"x": 0.3})])
     store.add_observation(Observation({"x": 0.2}, {"y": 2.0}, "b", {"note": "ok"}), raw='{"raw": 1}')
     store.add_observation(Observation({"x": 0.1}, {"y": None}, "a"))
-    # no close(): what add_observation returned is on disk, as after a crash
-    reopened = CampaignStore(path, CONFIG, "h1")
+    # no close(): what add_observation returned is on disk, as after a crash (read by a second connection)
+    reopened = CampaignStore.open_existing(path)
     assert [o.experiment_id for o in reopened.observations()] == ["b", "a"]
     assert reopened.observations()[1].failed
     assert [o.experiment_id for o in reopened.observations(skip=1)] == ["a"] and not reopened.observations(skip=2)
     assert [p.experiment_id for p in reopened.pending()] == ["c"]
     assert reopened.get_meta("config_hash") == "h1"
+
+
+def test_a_store_has_one_writer_readers_take_no_lock(tmp_path):
+    path = tmp_path / "c.sqlite"
+    writer = CampaignStore(path, CONFIG, "h1")
+    with pytest.raises(StoreError, match="is in use by pid"):
+        CampaignStore(path, CONFIG, "h1")
+    reader = CampaignStore.open_existing(path)
+    writer.add_observation(Observation({"x": 0.2}, {"y": 2.0}, "b"))
+    assert reader.count_observations() == 1  # a reader follows the writer
+    with pytest.raises(StoreError, match="for reading only"):
+        reader.add_observation(Observation({"x": 0.3}, {"y": 2.0}, "c"))
+    writer.close()
+    CampaignStore(path, CONFIG, "h1").close()  # free again once the writer closed
 
 
 def test_duplicate_experiment_is_refused(tmp_path):
@@ -75,6 +89,7 @@ def test_proposal_meta_is_stored_and_old_stores_gain_the_column(tmp_path):
     store = CampaignStore(path, CONFIG, "h1")
     store.add_proposals([Proposal("new", {"x": 0.1}, None, {"surrogate": "gp",
                                                            "loo_rank_correlation": {"kde": 0.2, "gp": 0.9}})])
+    store.close()
     reopened = CampaignStore(path, CONFIG, "h1")
     old, new = reopened.proposals()
     assert (old.experiment_id, old.meta, old.strategy) == ("old", {}, 1.0)

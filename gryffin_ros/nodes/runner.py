@@ -1,40 +1,60 @@
 """Start-up and shutdown shared by the nodes: loopback environment, a clear message and exit code 2 when the node
-cannot start, a clean shutdown on Ctrl-C or SIGTERM."""
+cannot start, a clean shutdown on Ctrl-C or SIGTERM.
+
+rclpy's own signal handler would invalidate the context at once, while callbacks may still be running in the
+executor's threads (their publishes then fail: "publisher's context is invalid"). Here a signal only ends the spin
+loop; then the node is told to stop publishing (`begin_shutdown`), `on_exit` releases what it holds (waiting for
+running callbacks where it must), and only then are the node and the context shut down.
+"""
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 from collections.abc import Callable
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
 
 from ..planner import GryffinRosError
 from ..rosenv import apply_to_this_process
+
+# How often the spin loop looks at the stop flag (the longest a signal waits to be noticed).
+STOP_POLL_S = 0.1
 
 
 def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None,
         executor: Callable[[], Executor] = SingleThreadedExecutor,
         on_exit: Callable[[Node], None] | None = None) -> int:
     apply_to_this_process()
-    rclpy.init(args=args)
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    stop = threading.Event()
+    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        node = make_node()
-    except GryffinRosError as exc:
-        print(f"{label}: cannot start: {exc}", file=sys.stderr)
-        rclpy.try_shutdown()
-        return 2
-    spinner = executor()
-    spinner.add_node(node)
-    try:
-        spinner.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        try:
+            node = make_node()
+        except GryffinRosError as exc:
+            print(f"{label}: cannot start: {exc}", file=sys.stderr)
+            return 2
+        spinner = executor()
+        spinner.add_node(node)
+        try:
+            while not stop.is_set() and rclpy.ok():
+                spinner.spin_once(timeout_sec=STOP_POLL_S)
+        except (KeyboardInterrupt, ExternalShutdownException):
+            pass
+        finally:
+            if hasattr(node, "begin_shutdown"):
+                node.begin_shutdown()
+            spinner.shutdown()
+            if on_exit is not None:
+                on_exit(node)
+            node.destroy_node()
+        return 0
     finally:
-        spinner.shutdown()
-        if on_exit is not None:
-            on_exit(node)
-        node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)

@@ -298,11 +298,26 @@ class BasePlanner:
                 if o.experiment_id in seen:
                     raise ObservationError(f"experiment_id '{o.experiment_id}' was already reported")
                 seen.add(o.experiment_id)
-        for o in parsed:
+        self.record(parsed)
+        return parsed
+
+    def record(self, observations: Sequence[Observation]) -> None:
+        """Add observations that `parse_observation` has already validated (and whose ids are new), without
+        validating them again: the path of a campaign that validates each observation once, when it arrives."""
+        for o in observations:
             self.observations.append(o)
             if o.experiment_id is not None:
                 self.pending.pop(o.experiment_id, None)
-        return parsed
+
+    def restore(self, observations: Sequence[Observation], pending: Sequence[Proposal], ask_count: int,
+                proposal_count: int) -> None:
+        """Put a fresh planner where a campaign left it: its validated observations, the proposals still pending
+        and its counters (which, with the seed, make the next proposals the same as without the restart)."""
+        if self.observations or self.pending:
+            raise RuntimeError("restore() is for a fresh planner")
+        self.record(observations)
+        self.pending = {p.experiment_id: p for p in pending}
+        self._ask_count, self._proposal_count = int(ask_count), int(proposal_count)
 
     def _internal(self, rows: Sequence[Mapping[str, Any]]) -> np.ndarray:
         return self.space.to_internal(rows) if rows else np.empty((0, self.space.dim))
@@ -444,12 +459,10 @@ class BasePlanner:
         if state.get("strategy") != cls.__name__:
             raise ConfigError(f"state was saved by {state.get('strategy')!r}, not {cls.__name__}")
         planner = cls(load_config(state["config"], base_dir), known_constraints, state["seed"])
-        planner.observations = [planner.parse_observation(o) for o in state["observations"]]
-        planner.pending = {p["experiment_id"]: Proposal(p["experiment_id"], p["params"], p.get("strategy"),
-                                                        dict(p.get("meta") or {}))
-                           for p in state["pending"]}
-        planner._ask_count = int(state["ask_count"])
-        planner._proposal_count = int(state["proposal_count"])
+        planner.restore([planner.parse_observation(o) for o in state["observations"]],
+                        [Proposal(p["experiment_id"], p["params"], p.get("strategy"), dict(p.get("meta") or {}))
+                         for p in state["pending"]],
+                        state["ask_count"], state["proposal_count"])
         return planner
 
 

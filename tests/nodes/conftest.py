@@ -161,7 +161,8 @@ class PlannerProcess:
                                         env=node_env(tmp_path), stdout=self.log, stderr=subprocess.STDOUT)
 
     def output(self) -> str:
-        self.log.flush()
+        if not self.log.closed:
+            self.log.flush()
         return self.log_path.read_text()
 
     def stop(self) -> int:

@@ -82,7 +82,7 @@ def test_restart_on_the_same_store_resumes_and_refuses_another_config(client, st
         client.publish(observation(proposal, value=0.3))
     client.wait_events(start + 3)
     assert planner.stop() == 0
-    start_planner(auto_propose=False)
+    restarted = start_planner(auto_propose=False)
     deadline = time.monotonic() + HANG_S
     while True:  # the old node's service may still be discovered for a moment
         status = client.status()
@@ -94,6 +94,14 @@ def test_restart_on_the_same_store_resumes_and_refuses_another_config(client, st
     client.publish(observation(proposals[3], value=0.8))
     client.wait_events(start + 4)
     assert client.status()["best"]["objectives"] == {"X1_X2": 0.8}
+    # an operator starts a second node on the same store: refused at once, naming the holder; the first serves on
+    second = start_planner(wait=False, auto_propose=False)
+    assert second.process.wait(timeout=HANG_S) == 2
+    assert f"is in use by pid {restarted.process.pid}" in second.output()
+    assert client.status()["n_observations"] == 4
+    assert restarted.process.poll() is None
+    assert restarted.stop() == 0
+    assert "Traceback" not in restarted.output()  # a clean shutdown: no callback publishing into a dead context
     other = {**FLOW_CONFIG, "constraints": ["F_C + F_S <= 100"]}
     refused = start_planner(other, wait=False, auto_propose=False)
     assert refused.process.wait(timeout=HANG_S) == 2

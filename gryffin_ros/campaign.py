@@ -1,0 +1,276 @@
+"""`Campaign`: the one owner of a campaign — its store, its planner and its bookkeeping — without ROS.
+
+The planner node, `gryffin-ros campaign` (with or without ROS) and the benchmarks that run campaigns all go through
+it; the node only translates messages. What it guarantees:
+
+- the store is held exclusively (a second process on the same file is refused at once, naming the holder);
+- each observation is validated exactly once, when it arrives, and committed before `observe` returns (a caller
+  acknowledges after `observe`, so nothing acknowledged can be lost); the planner learns it after the commit, and
+  if the planner cannot take it then, it is kept and taught again before the next proposal — never lost, never
+  reported twice;
+- experiment ids, pending proposals, failures and the best experiment are kept here, once;
+- restarting on the same store continues the campaign: same seed, same counters, the experiments still owed.
+
+Pending proposals follow one rule: a proposal stays pending until an observation reports it. Proposals published
+without being asked for (auto-propose) are *unclaimed*; `claim` (the node's recommend) hands out unclaimed pending
+proposals first, each once, and asks the planner only for the rest, so an auto-published batch is never left
+behind by a lab that asks for its experiments.
+"""
+
+from __future__ import annotations
+
+import copy
+import logging
+import secrets
+import threading
+import time
+import uuid
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from .planner import Observation, Planner, Proposal
+from .planner.config import PlannerConfig, load_config, read_config
+from .planner.errors import GryffinRosError
+from .storage import CampaignStore
+
+logger = logging.getLogger(__name__)
+
+ConstraintArg = Callable[[dict], bool] | Sequence[Callable[[dict], bool]] | None
+
+
+class Rejected(GryffinRosError):
+    """An observation the campaign refuses for its id (already reported, or never proposed); nothing is stored."""
+
+
+class CampaignClosed(GryffinRosError):
+    """The campaign has been closed (the process is shutting down); nothing more is stored."""
+
+
+class Campaign:
+    """A campaign over a store (default: in memory). `settings` override `general` keys that choose how to optimize,
+    not what (e.g. ``{"acquisition_optimizer": "genetic"}``): they are applied after the campaign's config hash, so
+    the same store can be resumed with other settings."""
+
+    def __init__(self, config: Mapping | str | Path, storage: str | Path = ":memory:", *, seed: int | None = None,
+                 known_constraints: ConstraintArg = None, settings: Mapping[str, Any] | None = None,
+                 accept_unsolicited: bool = False, base_dir: str | Path | None = None):
+        raw = read_config(config)
+        if base_dir is None and isinstance(config, (str, Path)):
+            base_dir = Path(config).resolve().parent
+        base = Path(base_dir) if base_dir is not None else None
+        checked = load_config(raw, base)  # validates; its hash identifies the campaign in the store
+        self.name = checked.name
+        self.accept_unsolicited = accept_unsolicited
+        self.store = CampaignStore(storage, checked.raw, checked.hash)
+        try:
+            stored_seed = self.store.get_meta("seed")
+            if seed is None:  # a campaign keeps its seed; a new one takes the config's, else a random one
+                seed = int(stored_seed) if stored_seed is not None else checked.general.random_seed
+            if seed is None:
+                seed = secrets.randbits(63)
+            self.store.set_meta("seed", str(seed))
+            tuned = copy.deepcopy(checked.raw)
+            if settings:
+                tuned.setdefault("general", {}).update(settings)
+            self.planner = Planner(load_config(tuned, base), known_constraints, seed)
+            observations = self.store.observations()
+            self.planner.restore(observations, self.store.pending(), int(self.store.get_meta("ask_count") or 0),
+                                 int(self.store.get_meta("proposal_count") or 0))
+        except BaseException:
+            self.store.close()
+            raise
+        self._state_lock = threading.Condition()  # bookkeeping below; never held while the planner works
+        self._active = 0  # observe() calls in progress (close waits for them)
+        self._closed = False
+        self._planner_lock = threading.Lock()  # the planner: one ask or one lesson at a time
+        self._reported = {o.experiment_id for o in observations}
+        self._pending: dict[str, Proposal] = dict(self.planner.pending)
+        self._unclaimed: list[str] = []  # pending ids published but not yet handed to anyone asking
+        self._inbox: list[Observation] = []  # committed, not yet learnt by the planner
+        self._n_failed = sum(o.failed for o in observations)
+        self._best = self.planner.best()
+        self._state = "idle"
+
+    # ---- read-outs -----------------------------------------------------------------------------------------
+    @property
+    def config(self) -> PlannerConfig:
+        return self.planner.config
+
+    @property
+    def seed(self) -> int:
+        return self.planner.seed
+
+    @property
+    def n_observations(self) -> int:
+        with self._state_lock:
+            return len(self._reported)
+
+    @property
+    def pending(self) -> list[Proposal]:
+        """Proposals still owed an observation, oldest first."""
+        with self._state_lock:
+            return list(self._pending.values())
+
+    @property
+    def best(self) -> Observation | None:
+        with self._state_lock:
+            return self._best
+
+    @property
+    def warnings(self) -> list[str]:
+        """Known constraints that exclude nothing (found when the feasible region is first studied)."""
+        return self.planner.constraint_warnings
+
+    def status(self) -> dict[str, Any]:
+        """Where the campaign stands (the node's status message)."""
+        with self._state_lock:
+            best = self._best
+            return {
+                "campaign": self.name, "n_observations": len(self._reported), "n_pending": len(self._pending),
+                "n_failed": self._n_failed, "state": self._state,
+                "best": None if best is None else {"experiment_id": best.experiment_id, "params": best.params,
+                                                   "objectives": best.objectives},
+                "warnings": self.warnings,
+            }
+
+    # ---- observations --------------------------------------------------------------------------------------
+    def observe(self, item: Mapping[str, Any] | Observation, raw: str | None = None) -> Observation:
+        """Validate one observation, commit it with the message it came in (`raw`), then teach the planner unless
+        it is busy (then before its next proposal). Raises ObservationError or Rejected (nothing stored)."""
+        with self._state_lock:
+            if self._closed:
+                raise CampaignClosed(f"campaign '{self.name}' is closed; the observation was not stored")
+            self._active += 1
+        try:
+            return self._observe(item, raw)
+        finally:
+            with self._state_lock:
+                self._active -= 1
+                self._state_lock.notify_all()
+
+    def _observe(self, item: Mapping[str, Any] | Observation, raw: str | None) -> Observation:
+        observation = self.planner.parse_observation(item)
+        with self._state_lock:
+            experiment_id = observation.experiment_id
+            if experiment_id is None:
+                if not self.accept_unsolicited:
+                    raise Rejected("an observation needs the experiment_id of the proposal it reports")
+                experiment_id = observation.experiment_id = str(uuid.uuid4())
+            if experiment_id in self._reported:
+                raise Rejected(f"experiment_id '{experiment_id}' was already reported; the first report stands")
+            if experiment_id not in self._pending and not self.accept_unsolicited:
+                raise Rejected(f"unknown experiment_id '{experiment_id}': this planner did not propose it (set "
+                               "accept_unsolicited to accept prior data)")
+            self._reported.add(experiment_id)  # claimed under the lock: a concurrent duplicate is refused above
+        try:
+            self.store.add_observation(observation, raw)
+        except BaseException:
+            with self._state_lock:
+                self._reported.discard(experiment_id)
+            raise
+        with self._state_lock:
+            self._inbox.append(observation)
+            self._pending.pop(experiment_id, None)
+            if experiment_id in self._unclaimed:
+                self._unclaimed.remove(experiment_id)
+            self._n_failed += observation.failed
+        if self._planner_lock.acquire(blocking=False):  # never wait for a running optimization here
+            try:
+                self._absorb()
+            except Exception:  # committed is committed: the planner is taught again before its next proposal
+                logger.exception("the planner could not learn observation %s now; it is kept and taught again "
+                                 "before the next proposal", experiment_id)
+            finally:
+                self._planner_lock.release()
+        return observation
+
+    def _absorb(self) -> None:
+        """Teach the planner what was committed since last time (caller holds the planner lock). If the planner
+        raises, the observations stay in the inbox for the next try: committed data is never dropped."""
+        with self._state_lock:
+            inbox = list(self._inbox)
+        if not inbox:
+            return
+        self.planner.record(inbox)
+        best = self.planner.best()
+        with self._state_lock:
+            del self._inbox[:len(inbox)]
+            self._best = best
+
+    def absorb(self) -> None:
+        """Teach the planner every committed observation now (waits for a running optimization)."""
+        with self._planner_lock:
+            self._absorb()
+
+    # ---- proposals -----------------------------------------------------------------------------------------
+    def propose(self, n: int | None = None, claimed: bool = True) -> list[Proposal]:
+        """`n` new proposals (default general.batches), stored before they are returned. `claimed=False` marks
+        them as published without being asked for (auto-propose), so that `claim` hands them out later."""
+        with self._planner_lock:
+            with self._state_lock:
+                self._state = "optimizing"
+            try:
+                self._absorb()
+                proposals = self.planner.ask(n)
+                self.store.add_proposals(proposals, {"ask_count": str(self.planner.ask_count),
+                                                     "proposal_count": str(self.planner.proposal_count)})
+            except BaseException:
+                with self._state_lock:
+                    self._state = "error"
+                raise
+            with self._state_lock:
+                self._pending.update((p.experiment_id, p) for p in proposals)
+                if not claimed:
+                    self._unclaimed += [p.experiment_id for p in proposals]
+                self._state = "idle"
+            self._absorb()  # what arrived while optimizing
+        return proposals
+
+    def claim(self, n: int | None = None) -> list[Proposal]:
+        """`n` proposals for someone who asks (the node's recommend): unclaimed pending ones first, each handed out
+        once, then new ones."""
+        n = self.config.general.batches if n is None else n
+        with self._state_lock:
+            taken, self._unclaimed = self._unclaimed[:n], self._unclaimed[n:]
+            handed = [self._pending[i] for i in taken]
+        if len(handed) < n:
+            handed += self.propose(n - len(handed))
+        return handed
+
+    def owed(self) -> list[Proposal]:
+        """Pending proposals to announce again (after a restart, or when the lab has gone quiet)."""
+        return self.pending
+
+    def mark_unclaimed(self) -> None:
+        """Every pending proposal becomes unclaimed again (after a restart they are announced to everyone)."""
+        with self._state_lock:
+            self._unclaimed = list(self._pending)
+
+    # ---- lifetime ------------------------------------------------------------------------------------------
+    def close(self) -> None:
+        """Refuse new observations, wait for those being stored and for a running optimization to finish its
+        writes, then release the store."""
+        with self._state_lock:
+            if self._closed:
+                return
+            self._closed = True
+            self._state_lock.wait_for(lambda: self._active == 0)
+        with self._planner_lock:
+            self.store.close()
+
+    def __enter__(self) -> Campaign:
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.close()
+
+
+def wait_for(condition: Callable[[], bool], timeout: float, interval: float = 0.05) -> bool:
+    """Poll `condition` until it holds or `timeout` seconds pass; whether it held."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(interval)
+    return True

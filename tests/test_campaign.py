@@ -1,0 +1,184 @@
+"""Campaign: one owner of the store, the planner and the bookkeeping — tested without DDS."""
+
+import json
+import sqlite3
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from gryffin_ros import messages
+from gryffin_ros.campaign import Campaign, CampaignClosed, Rejected
+from gryffin_ros.planner import ObservationError
+from gryffin_ros.storage import StoreError
+
+CONFIG = {
+    "name": "campaign_test",
+    "parameters": [{"name": "x", "type": "continuous", "low": 0.0, "high": 10.0},
+                   {"name": "solvent", "type": "categorical", "options": ["THF", "DMF", "MeCN"]}],
+    "objectives": [{"name": "y", "goal": "max"}],
+    "constraints": ["x < 6 if solvent == 'THF' else x < 9"],
+}
+
+
+def report(proposal, value=1.0):
+    return {"experiment_id": proposal.experiment_id, "params": proposal.params, "objectives": {"y": value}}
+
+
+def stored_ids(path):
+    with sqlite3.connect(path) as db:
+        return [row[0] for row in db.execute("SELECT experiment_id FROM observations ORDER BY seq")]
+
+
+def test_each_observation_is_validated_once_and_learnt_without_parsing_again(tmp_path, monkeypatch):
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    calls = []
+    parse = campaign.planner.parse_observation
+    monkeypatch.setattr(campaign.planner, "parse_observation", lambda item: calls.append(item) or parse(item))
+    for proposal in campaign.propose(3):
+        campaign.observe(report(proposal))
+    campaign.propose(1)  # learning and asking again parse nothing
+    assert len(calls) == 3
+    assert len(campaign.planner.observations) == 3
+
+
+def test_an_observation_the_planner_cannot_take_after_the_commit_is_neither_lost_nor_double_reported(
+        tmp_path, monkeypatch):
+    path = tmp_path / "c.sqlite"
+    campaign = Campaign(CONFIG, path, seed=0)
+    first, second = campaign.propose(2)
+    record = campaign.planner.record
+
+    def broken(observations):
+        raise RuntimeError("planner busy elsewhere")
+    monkeypatch.setattr(campaign.planner, "record", broken)
+    observation = campaign.observe(report(first))  # committed: the caller may acknowledge it
+    assert stored_ids(path) == [first.experiment_id]
+    assert campaign.n_observations == 1 and campaign.planner.observations == []
+    with pytest.raises(Rejected, match="already reported"):
+        campaign.observe(report(first, value=2.0))
+    with pytest.raises(RuntimeError):  # the planner still cannot learn: nothing is proposed, nothing dropped
+        campaign.propose(1)
+    monkeypatch.setattr(campaign.planner, "record", record)
+    campaign.observe(report(second))
+    assert [o.experiment_id for o in campaign.planner.observations] == [first.experiment_id, second.experiment_id]
+    assert campaign.planner.observations[0] is observation
+    assert stored_ids(path) == [first.experiment_id, second.experiment_id]
+
+
+def test_refused_observations_store_nothing(tmp_path):
+    path = tmp_path / "c.sqlite"
+    campaign = Campaign(CONFIG, path, seed=0)
+    [proposal] = campaign.propose(1)
+    with pytest.raises(ObservationError, match="violate the known constraint"):
+        campaign.observe({**report(proposal), "params": {"x": 7.0, "solvent": "THF"}})
+    with pytest.raises(Rejected, match="did not propose it"):
+        campaign.observe({**report(proposal), "experiment_id": "made-up"})
+    with pytest.raises(Rejected, match="needs the experiment_id"):
+        campaign.observe({"params": proposal.params, "objectives": {"y": 1.0}})
+    assert stored_ids(path) == [] and campaign.pending == [proposal]
+    prior = Campaign(CONFIG, tmp_path / "prior.sqlite", seed=0, accept_unsolicited=True)
+    prior.observe({"params": {"x": 1.0, "solvent": "DMF"}, "objectives": {"y": 0.3}})
+    prior.observe({"experiment_id": "lab-7", "params": {"x": 2.0, "solvent": "DMF"}, "objectives": {"y": None}})
+    assert prior.status()["n_observations"] == 2 and prior.status()["n_failed"] == 1
+
+
+def test_the_message_is_stored_as_it_arrived(tmp_path):
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    [proposal] = campaign.propose(1)
+    text = '{"experiment_id": "%s", "params": %s, "objectives": {"y": 1}}' % (
+        proposal.experiment_id, json.dumps(proposal.params))
+    campaign.observe(messages.parse("observation", text), raw=text)
+    assert campaign.store.raw(proposal.experiment_id) == text
+
+
+def test_a_restart_continues_the_campaign_exactly(tmp_path):
+    straight = Campaign(CONFIG, tmp_path / "a.sqlite", seed=3)
+    for proposal in straight.propose(2):
+        straight.observe(report(proposal, proposal.params["x"]))
+    expected = straight.propose(2)
+
+    first = Campaign(CONFIG, tmp_path / "b.sqlite", seed=3)
+    for proposal in first.propose(2):
+        first.observe(report(proposal, proposal.params["x"]))
+    first.close()
+    resumed = Campaign(CONFIG, tmp_path / "b.sqlite")  # the seed comes from the store
+    assert resumed.seed == 3 and resumed.n_observations == 2 and resumed.pending == []
+    # same seed, same observations, same counters, same process: the very same computation
+    assert [p.params for p in resumed.propose(2)] == [p.params for p in expected]
+    resumed.close()
+    again = Campaign(CONFIG, tmp_path / "b.sqlite")
+    assert len(again.pending) == 2 and again.planner.ask_count == 2
+
+
+def test_another_config_cannot_take_over_a_store(tmp_path):
+    Campaign(CONFIG, tmp_path / "c.sqlite", seed=0).close()
+    with pytest.raises(StoreError, match="belongs to a different config"):
+        Campaign({**CONFIG, "constraints": []}, tmp_path / "c.sqlite")
+    Campaign(CONFIG, tmp_path / "c.sqlite").close()  # the refused attempt left the store free
+
+
+HOLDER = textwrap.dedent("""
+    import sys
+    from gryffin_ros.campaign import Campaign
+    campaign = Campaign({config!r}, {path!r}, seed=0)
+    print("holding", flush=True)
+    sys.stdin.read()  # until the test closes stdin (or kills this process)
+""")
+
+
+def test_a_store_has_one_writer_and_a_killed_writer_frees_it(tmp_path):
+    path = tmp_path / "c.sqlite"
+    holder = subprocess.Popen([sys.executable, "-c", HOLDER.format(config=CONFIG, path=str(path))],
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "holding"
+        with pytest.raises(StoreError) as info:
+            Campaign(CONFIG, path)
+        assert f"'{path}' is in use by pid {holder.pid}" in str(info.value)
+        with Campaign(CONFIG, tmp_path / "other.sqlite"):
+            pass  # another file is free
+    finally:
+        holder.kill()
+        holder.wait()
+    with Campaign(CONFIG, path) as campaign:  # the operating system released the dead writer's lock
+        assert campaign.seed == 0
+
+
+def test_auto_published_proposals_are_handed_out_first_by_claim(tmp_path):
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    published = campaign.propose(2, claimed=False)
+    first = campaign.claim(1)
+    second = campaign.claim(2)
+    assert first == published[:1]
+    assert second[0] == published[1] and second[1] not in published
+    assert len(campaign.pending) == 3
+    third = campaign.claim(1)
+    assert third[0] not in published + second  # nothing is handed out twice
+    campaign.observe(report(published[0]))
+    campaign.mark_unclaimed()  # a restart announces everything owed again
+    assert [p.experiment_id for p in campaign.claim(3)] == [p.experiment_id for p in campaign.pending]
+
+
+def test_status_follows_the_campaign_and_fits_the_schema(tmp_path):
+    campaign = Campaign({**CONFIG, "constraints": [*CONFIG["constraints"], "x < 50"]}, tmp_path / "c.sqlite",
+                        seed=0)
+    proposals = campaign.propose(2)
+    campaign.observe(report(proposals[0], 0.2))
+    campaign.observe({**report(proposals[1]), "objectives": {"y": None}})
+    status = campaign.status()
+    messages.check("status", status)
+    assert (status["n_observations"], status["n_pending"], status["n_failed"]) == (2, 0, 1)
+    assert status["best"]["experiment_id"] == proposals[0].experiment_id
+    assert len(status["warnings"]) == 1 and "'x < 50' excludes no point" in status["warnings"][0]
+
+
+def test_a_closed_campaign_stores_nothing_more(tmp_path):
+    path = tmp_path / "c.sqlite"
+    campaign = Campaign(CONFIG, path, seed=0)
+    [proposal] = campaign.propose(1)
+    campaign.close()
+    with pytest.raises(CampaignClosed):
+        campaign.observe(report(proposal))
+    assert stored_ids(path) == []
