@@ -87,8 +87,9 @@ def test_refused_observations_store_nothing(tmp_path):
 def test_the_message_is_stored_as_it_arrived(tmp_path):
     campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
     [proposal] = campaign.propose(1)
-    text = '{"experiment_id": "%s", "params": %s, "objectives": {"y": 1}}' % (
-        proposal.experiment_id, json.dumps(proposal.params))
+    # spacing and key order of the sender's own: kept as it arrived, not re-serialized
+    text = f'{{"objectives": {{"y": 1}},   "experiment_id": "{proposal.experiment_id}", ' \
+           f'"params": {json.dumps(proposal.params)}}}'
     campaign.observe(messages.parse("observation", text), raw=text)
     assert campaign.store.raw(proposal.experiment_id) == text
 
