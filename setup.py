@@ -44,5 +44,9 @@ setup(
             "flow_reactor_node = gryffin_ros.nodes.emulator_node:flow_reactor_main",
             "redox_node = gryffin_ros.nodes.emulator_node:redox_main",
         ],
+        # the flow reactor's known constraints, a plugin of its emulator package (docs/configuration.md)
+        "gryffin_ros.constraints": [
+            "flow_reactor = gryffin_ros.emulators.flow_reactor:flow_reactor_constraint",
+        ],
     },
 )

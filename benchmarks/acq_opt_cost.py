@@ -21,9 +21,9 @@ import numpy as np
 import torch
 
 from gryffin_ros.planner import Planner, vectorized
-from gryffin_ros.planner.acquisition import Acquisition
-from gryffin_ros.planner.kernel_density import KernelDensity
-from gryffin_ros.planner.planner import SPACING_FACTOR
+from gryffin_ros.planner.acquisition.kernel import Acquisition
+from gryffin_ros.planner.strategies.gryffin import SPACING_FACTOR
+from gryffin_ros.planner.surrogates.kernel_density import KernelDensity
 
 DIMS = (1, 2, 3, 4, 6, 8, 10)
 NUM_OBS = (10, 100, 200, 300, 400, 500)
@@ -60,8 +60,8 @@ def time_case(d: int, n: int, constrained: bool, optimizer: str, repeats: int) -
                                 spacing_factor=SPACING_FACTOR)
         for s in acq:
             tick = time.perf_counter()
-            start, _ = planner._start_points(rng, X[int(np.argmin(merits))], X)
-            planner._optimizer().optimize(Acquisition(density, s), start, rng)
+            start, _ = planner.start_points(rng, X[int(np.argmin(merits))], X)
+            planner.optimizer().optimize(Acquisition(density, s), start, rng)
             acq[s].append(time.perf_counter() - tick)
         tick = time.perf_counter()
         planner.ask(2)

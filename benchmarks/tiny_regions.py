@@ -6,7 +6,7 @@ ask/tell rounds on a quadratic objective with its minimum inside (off-centre in 
 
     python benchmarks/tiny_regions.py [--dims 4 6] [--asks 8] [--out benchmarks/results]
 
-"Rejection only" is the planner with the hit-and-run sampler switched off (monkeypatched here, for this comparison
+"Rejection only" is the planner with the hit-and-run sampler switched off (its `walk` replaced, for this comparison
 only): start points are then uniform draws (at most general.max_rejection_draws per call) and ±5 % perturbations of
 the best experiment.
 """
@@ -24,7 +24,6 @@ from pathlib import Path
 import numpy as np
 import torch
 
-import gryffin_ros.planner.planner as planner_module
 from gryffin_ros.planner import GryffinRosError, Planner
 
 FRACTIONS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
@@ -51,29 +50,25 @@ def campaign(d: int, fraction: float, asks: int, walk: bool, shape: str = "ball"
         config["constraints"] = [" + ".join(names) + f" <= {r!r}"]
         target = np.full(d, r / (d + 1))  # the centroid
         inside_fn = lambda x: x.sum() <= r * (1 + 1e-12)  # noqa: E731
-    original = planner_module.hit_and_run
-    if not walk:
-        planner_module.hit_and_run = lambda constraints, rng, seeds, m, **kw: np.empty((0, constraints.space.dim))
-    try:
-        planner = Planner(config, seed=seed)
-        planner.tell({**{f"x{i}": centre for i in range(d)}, "y": float(((centre - target) ** 2).sum())})
-        times, inside, error = [], 0, None
-        for _ in range(asks):
-            tick = time.perf_counter()
-            try:
-                (proposal,) = planner.ask()
-            except GryffinRosError as exc:
-                error = f"{type(exc).__name__}: {str(exc)[:80]}"
-                times.append(time.perf_counter() - tick)
-                break
+    planner = Planner(config, seed=seed)
+    if not walk:  # rejection sampling alone: the planner's walk inside the feasible region returns nothing
+        planner.region.walk = lambda constraints, rng, seeds, m, **kw: np.empty((0, constraints.space.dim))
+    planner.tell({**{f"x{i}": centre for i in range(d)}, "y": float(((centre - target) ** 2).sum())})
+    times, inside, error = [], 0, None
+    for _ in range(asks):
+        tick = time.perf_counter()
+        try:
+            (proposal,) = planner.ask()
+        except GryffinRosError as exc:
+            error = f"{type(exc).__name__}: {str(exc)[:80]}"
             times.append(time.perf_counter() - tick)
-            x = np.array([proposal.params[f"x{i}"] for i in range(d)])
-            inside += bool(inside_fn(x))
-            planner.tell({**proposal.params, "y": float(((x - target) ** 2).sum()),
-                          "experiment_id": proposal.experiment_id})
-        best = planner.best().objectives["y"]
-    finally:
-        planner_module.hit_and_run = original
+            break
+        times.append(time.perf_counter() - tick)
+        x = np.array([proposal.params[f"x{i}"] for i in range(d)])
+        inside += bool(inside_fn(x))
+        planner.tell({**proposal.params, "y": float(((x - target) ** 2).sum()),
+                      "experiment_id": proposal.experiment_id})
+    best = planner.best().objectives["y"]
     return {"d": d, "shape": shape, "fraction": fraction, "walk": walk, "median_ask": statistics.median(times),
             "max_ask": max(times), "proposals": len(planner.observations) - 1, "inside": inside, "error": error,
             "best_over_r2": best / (r * r)}

@@ -23,11 +23,12 @@ from typing import Any
 import numpy as np
 import torch
 
-from .planner.acquisition import Acquisition
+from .planner.acquisition.kernel import Acquisition
 from .planner.config import PlannerConfig, load_config, read_config
 from .planner.errors import ConfigError, GryffinRosError, ObservationError
-from .planner.kernel_density import KernelDensity, split
-from .planner.planner import OBJ_TRANSFORMS, SPACING_FACTOR, Planner, Surrogates
+from .planner.strategies.base import OBJ_TRANSFORMS
+from .planner.strategies.gryffin import SPACING_FACTOR, Planner, Surrogates
+from .planner.surrogates.kernel_density import KernelDensity, split
 
 __all__ = ["Gryffin", "UnsupportedError"]
 

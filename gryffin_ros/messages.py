@@ -12,8 +12,8 @@ from typing import Any
 import jsonschema
 
 from .paths import share_path
+from .planner.domain import Proposal
 from .planner.errors import GryffinRosError
-from .planner.planner import Proposal
 
 SCHEMAS = ("observation", "proposals", "event", "status", "error")
 # Larger messages are refused before they are parsed.

@@ -1,7 +1,7 @@
 """The Gryffin 1.0 drop-in class (gryffin_ros.compat.Gryffin) and Gryffin 1.0's configuration keys.
 
 Gryffin 1.0's own test suite runs against the same class from ../shared/compat/gryffin1/run.sh; these tests check
-what it does not: every documented key, argument semantics, the read-outs and the README's Gryffin script.
+what it does not: every documented key, argument semantics, the read-outs and the Gryffin script of docs/gryffin1.md.
 """
 
 import json
@@ -16,7 +16,7 @@ import pytest
 from gryffin_ros.compat import Gryffin, UnsupportedError
 from gryffin_ros.planner import ConfigError, GryffinRosError, ObservationError, Planner, load_config
 from gryffin_ros.planner.notices import forget_notices
-from gryffin_ros.planner.selection import diversity
+from gryffin_ros.planner.strategies.selection import diversity
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -360,14 +360,14 @@ def test_descriptor_summaries():
     assert gryffin.get_descriptor_summary_feasibility() == {}  # nothing failed
 
 
-# ---- the README's Gryffin script -------------------------------------------------------------------------------------
+# ---- the Gryffin script of docs/gryffin1.md --------------------------------------------------------------------------
 def test_readme_gryffin_script_runs(capsys):
-    text = (ROOT / "README.md").read_text()
-    section = text.split("## Gryffin 1.0 users", 1)[1]
+    text = (ROOT / "docs" / "gryffin1.md").read_text()
+    section = text.split("# Gryffin 1.0 users", 1)[1]
     script = re.search(r"```python\n(.*?)```", section, re.S).group(1)
     assert script.startswith("from gryffin_ros.compat import Gryffin")
     namespace = {}
-    exec(compile(script, "README.md", "exec"), namespace)  # noqa: S102 - our own README
+    exec(compile(script, "docs/gryffin1.md", "exec"), namespace)  # noqa: S102 - our own docs
     out = capsys.readouterr().out
     assert "feasible fraction of the domain" in out
     observations = namespace["observations"]

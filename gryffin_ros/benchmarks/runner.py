@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..planner import Genetic, GryffinRosError, Planner, Random
-from ..planner.planner import BasePlanner
+from ..planner.strategies import BasePlanner
 from .surfaces import SURFACES, ContinuousSurface, DiscreteSurface
 
 # adam/genetic: the kernel density under either acquisition optimizer; gp/auto: general.surrogate gp/auto with Adam

@@ -7,11 +7,16 @@ forward pass (weights drawn from their mean-field Gaussians), so repeated experi
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
+from typing import Any
 
 import numpy as np
+
+from ..planner.constraints import Expression, NamedConstraint
+from ..planner.errors import ConfigError
 
 LAYERS = ("blinear1", "blinear2", "blinear3", "blinear4")
 OUTPUTS = ("X0", "X1", "X2", "X3", "X1_X2", "cost")
@@ -86,3 +91,22 @@ class FlowReactorEmulator:
     def measure(self, params: Mapping[str, float]) -> dict[str, float]:
         """One experiment from a parameter dict (names in `parameters`): every output."""
         return self.run(*(float(params[n]) for n in self.parameters)).as_dict()
+
+
+# ---- the reactor's known constraints, registered as the constraint plugin `flow_reactor` (setup.py) -----------
+def flow_reactor_constraint(options: Mapping[str, Any], parameters: Mapping[str, Any]) -> NamedConstraint:
+    """Flow limits of the C60 reactor: min_total < F_C + F_S < max_total, and each flow below ratio x the other."""
+    allowed = {"min_total", "max_total", "ratio", "c60_flow", "sultine_flow"}
+    unknown = set(options) - allowed
+    if unknown:
+        raise ConfigError(f"flow_reactor constraint: unknown option(s) {sorted(unknown)}; allowed {sorted(allowed)}")
+    fc, fs = options.get("c60_flow", "F_C"), options.get("sultine_flow", "F_S")
+    low, high, ratio = options.get("min_total", 30.0), options.get("max_total", 310.0), options.get("ratio", 2.0)
+    for key, value in (("min_total", low), ("max_total", high), ("ratio", ratio)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ConfigError(f"flow_reactor constraint: '{key}' must be a finite number, got {value!r}")
+    if not low < high:
+        raise ConfigError(f"flow_reactor constraint: min_total ({low}) must be below max_total ({high})")
+    text = f"{low!r} < {fc} + {fs} < {high!r} and {fc} < {ratio!r} * {fs} and {fs} < {ratio!r} * {fc}"
+    expression = Expression(text, parameters, parameters)
+    return NamedConstraint(f"flow_reactor({text})", expression, expression.evaluate)

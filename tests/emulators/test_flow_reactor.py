@@ -8,6 +8,7 @@ import pytest
 
 from gryffin_ros.emulators import FlowReactorEmulator
 from gryffin_ros.emulators.flow_reactor import reagent_cost
+from gryffin_ros.planner import ConfigError, KnownConstraints, SearchSpace
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "fullerenes_emulator_data.csv"
 
@@ -46,3 +47,29 @@ def test_one_experiment_is_one_stochastic_pass_with_cost():
 def test_same_seed_same_experiments():
     a, b = FlowReactorEmulator(seed=5), FlowReactorEmulator(seed=5)
     assert [a.run(50, 60, 120) for _ in range(3)] == [b.run(50, 60, 120) for _ in range(3)]
+
+
+# ---- the reactor's constraint plugin (registered by this package under gryffin_ros.constraints) ---------------
+def test_flow_reactor_plugin_uses_configurable_bounds():
+    space = SearchSpace.from_config([{"name": "F_C", "type": "continuous", "low": 0, "high": 200},
+                                     {"name": "F_S", "type": "continuous", "low": 0, "high": 200}])
+    c = KnownConstraints.build(space, [{"plugin": "flow_reactor", "options": {"min_total": 10}}])
+    assert c.is_feasible({"F_C": 10.0, "F_S": 10.0})
+    assert not c.is_feasible({"F_C": 3.0, "F_S": 4.0})
+    assert not c.is_feasible({"F_C": 150.0, "F_S": 170.0})  # total above 310
+    assert not c.is_feasible({"F_C": 100.0, "F_S": 40.0})  # F_C >= 2 F_S
+    default = KnownConstraints.build(space, [{"plugin": "flow_reactor"}])
+    assert not default.is_feasible({"F_C": 10.0, "F_S": 10.0})  # total 20 <= 30
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"max_flow": 3}, "unknown option(s) ['max_flow']"),
+    ({"min_total": 400}, "must be below max_total"),
+    ({"c60_flow": "F_X"}, "unknown name 'F_X'"),
+])
+def test_flow_reactor_plugin_options_are_checked_at_load(options, message):
+    space = SearchSpace.from_config([{"name": "F_C", "type": "continuous", "low": 0, "high": 200},
+                                     {"name": "F_S", "type": "continuous", "low": 0, "high": 200}])
+    with pytest.raises(ConfigError) as info:
+        KnownConstraints.build(space, [{"plugin": "flow_reactor", "options": options}])
+    assert message in str(info.value)

@@ -1,0 +1,268 @@
+"""The ask/tell core shared by every strategy: campaign state and validation, the feasible set, determinism and
+the JSON state.
+
+A strategy only implements ``_propose(n, rng)``; validation of observations, pending proposals, determinism (every
+random draw derives from the seed, the number of observations and the number of asks), ``best()`` and the JSON state
+live in :class:`BasePlanner`.
+"""
+
+from __future__ import annotations
+
+import logging
+import secrets
+import uuid
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..chimera import Chimera
+from ..config import PlannerConfig, load_config
+from ..constraints import FeasibleFraction, KnownConstraints
+from ..constraints.equalities import LinearEqualities
+from ..domain import ConstraintArg, Observation, Proposal
+from ..errors import ConfigError, ObservationError
+from .feasible import FeasibleRegion
+from .observations import ObservationReader
+
+logger = logging.getLogger(__name__)
+
+STATE_FORMAT = 1
+
+
+def _identity(f: np.ndarray) -> np.ndarray:
+    return f
+
+
+# general.obj_transform on merits in [0, 1] (0 best), as in Gryffin ("identity" is its None), and each inverse:
+# sqrt and cbrt accentuate the best region (cbrt more so), square de-emphasizes it
+OBJ_TRANSFORMS: dict[str, tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray], np.ndarray]]] = {
+    "sqrt": (np.sqrt, np.square), "cbrt": (np.cbrt, lambda f: f ** 3), "square": (np.square, np.sqrt),
+    "identity": (_identity, _identity),
+}
+
+
+class BasePlanner:
+    """Campaign state and validation shared by the kernel-density Planner and the Random/Genetic baselines."""
+
+    def __init__(self, config: Mapping | str | Path | PlannerConfig, known_constraints: ConstraintArg = None,
+                 seed: int | None = None):
+        self.config = config if isinstance(config, PlannerConfig) else load_config(config)
+        full = self.config.space
+        # every parameter the user sees; `space` holds the ones the planner models (equality-solved ones excluded)
+        self.parameter_names: tuple[str, ...] = full.names
+        self.equalities, specs = LinearEqualities.split(self.config.constraint_specs, full)
+        self.space = self.equalities.reduced_space(full) if self.equalities else full
+        self.objectives = self.config.objectives
+        self.constraints = KnownConstraints.build(self.space, specs, known_constraints, parameters=full.parameters)
+        if self.equalities:  # the solved parameters' bounds first; every check sees the solved parameters too
+            self.constraints = KnownConstraints(
+                self.space, self.equalities.bound_constraints(full) + self.constraints.constraints,
+                self.equalities.complete_columns, self._complete)
+        self._known_constraints = known_constraints
+        self._reader = ObservationReader(self.space, full, self.equalities, self.objectives, self.constraints)
+        if seed is None:
+            seed = self.config.general.random_seed
+        if seed is None:
+            seed = secrets.randbits(63)
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
+        self.seed = int(seed)
+        self.observations: list[Observation] = []
+        self.pending: dict[str, Proposal] = {}
+        self._ask_count = 0
+        self._proposal_count = 0
+        # the feasible region of the known constraints: V_C, uniform and walked feasible draws, a finite feasible set
+        self.region = FeasibleRegion(self.constraints, self.config.general, self.seed)
+        self._strategies: np.ndarray | None = None  # sampling strategies replacing the config's (recommend)
+
+    def _complete(self, params: Mapping[str, Any]) -> dict[str, Any]:
+        """The modelled parameters of a point -> all parameters (equality-solved ones computed), in config order."""
+        return self.equalities.complete(params, self.parameter_names) if self.equalities else dict(params)
+
+    @property
+    def ask_count(self) -> int:
+        """How many times ask() has run (part of what makes proposals reproducible)."""
+        return self._ask_count
+
+    @property
+    def proposal_count(self) -> int:
+        """How many proposals have been made (the sampling strategies cycle with it)."""
+        return self._proposal_count
+
+    # ---- randomness ------------------------------------------------------------------------------------------
+    def _rng(self) -> np.random.Generator:
+        """Same seed, same observations, same number of asks -> same draws."""
+        return np.random.default_rng([self.seed, len(self.observations), self._ask_count, 2])
+
+    # ---- feasible region ------------------------------------------------------------------------------------
+    @property
+    def constraint_warnings(self) -> list[str]:
+        """One warning per known constraint that excludes no point of the domain (logged when first computed)."""
+        return self.region.warnings
+
+    @property
+    def feasible_fraction(self) -> FeasibleFraction:
+        """V_C: given in the config, exact for finite spaces up to 10^6 points, else Monte Carlo (cached)."""
+        return self.region.fraction(known_feasible=bool(self.observations))
+
+    def feasible_pool(self) -> np.ndarray:
+        """Known feasible points: uniform hits met while estimating V_C, observed and pending experiments."""
+        return self.region.pool(self.observed_points(), self.pending_points())
+
+    def feasible_set(self) -> np.ndarray | None:
+        """Every feasible point of a finite space small enough to search exhaustively, else None (cached)."""
+        return self.region.finite_set()
+
+    def random_points(self, n: int, rng: np.random.Generator, avoid: np.ndarray) -> np.ndarray:
+        """n feasible points drawn uniformly, none duplicating `avoid` or each other in a finite space."""
+        return self.region.random_points(n, rng, avoid, self.feasible_pool, bool(self.observations))
+
+    # ---- observations ----------------------------------------------------------------------------------------
+    def parse_observation(self, item: Mapping[str, Any] | Observation) -> Observation:
+        """Validate one observation: Gryffin style (parameters and objectives as keys, optional experiment_id) or
+        structured ``{experiment_id, params, objectives, meta}``. Raises ObservationError naming what is wrong."""
+        return self._reader.parse(item)
+
+    def tell(self, observations: Mapping | Observation | Sequence[Mapping | Observation]) -> list[Observation]:
+        """Add observations (all or none: the whole batch is validated first). Returns the stored Observations."""
+        if isinstance(observations, (Mapping, Observation)):
+            observations = [observations]
+        parsed = [self.parse_observation(o) for o in observations]
+        seen = {o.experiment_id for o in self.observations if o.experiment_id is not None}
+        for o in parsed:
+            if o.experiment_id is not None:
+                if o.experiment_id in seen:
+                    raise ObservationError(f"experiment_id '{o.experiment_id}' was already reported")
+                seen.add(o.experiment_id)
+        self.record(parsed)
+        return parsed
+
+    def record(self, observations: Sequence[Observation]) -> None:
+        """Add observations that `parse_observation` has already validated (and whose ids are new), without
+        validating them again: the path of a campaign that validates each observation once, when it arrives."""
+        for o in observations:
+            self.observations.append(o)
+            if o.experiment_id is not None:
+                self.pending.pop(o.experiment_id, None)
+
+    def restore(self, observations: Sequence[Observation], pending: Sequence[Proposal], ask_count: int,
+                proposal_count: int) -> None:
+        """Put a fresh planner where a campaign left it: its validated observations, the proposals still pending
+        and its counters (which, with the seed, make the next proposals the same as without the restart)."""
+        if self.observations or self.pending:
+            raise RuntimeError("restore() is for a fresh planner")
+        self.record(observations)
+        self.pending = {p.experiment_id: p for p in pending}
+        self._ask_count, self._proposal_count = int(ask_count), int(proposal_count)
+
+    def _internal(self, rows: Sequence[Mapping[str, Any]]) -> np.ndarray:
+        return self.space.to_internal(rows) if rows else np.empty((0, self.space.dim))
+
+    def observed_points(self) -> np.ndarray:
+        return self._internal([o.params for o in self.observations])
+
+    def pending_points(self) -> np.ndarray:
+        return self._internal([p.params for p in self.pending.values()])
+
+    def merits(self, observations: Sequence[Observation], transform: bool = True) -> np.ndarray:
+        """Successful observations -> minimization merits in [0, 1]: one objective rescaled (max goals negated),
+        several scalarized by Chimera; then (transform) the objective transform (sqrt by default)."""
+        if not observations:
+            return np.empty(0)
+        Y = np.array([[o.objectives[obj.name] for obj in self.objectives] for o in observations], dtype=float)
+        if len(self.objectives) > 1:
+            f = Chimera(self.objectives, self.config.general.softness).merits(Y)
+        else:
+            y = -Y[:, 0] if self.objectives[0].goal == "max" else Y[:, 0]
+            span = y.max() - y.min()
+            f = (y - y.min()) / span if span > 0 else np.zeros_like(y)
+        return OBJ_TRANSFORMS[self.config.general.obj_transform][0](f) if transform else f
+
+    def best(self) -> Observation | None:
+        """The best successful observation so far (None before the first one)."""
+        successful = [o for o in self.observations if not o.failed]
+        if not successful:
+            return None
+        return successful[int(np.argmin(self.merits(successful)))]
+
+    # ---- proposals -------------------------------------------------------------------------------------------
+    def ask(self, n: int | None = None) -> list[Proposal]:
+        """The next n proposals (default: general.batches); each feasible, none repeating a point of a finite space
+        that was observed or is pending."""
+        n = self.config.general.batches if n is None else n
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise ValueError(f"n must be a positive integer, got {n!r}")
+        rng = self._rng()
+        points, strategies, meta = self._propose(n, rng)
+        self._ask_count += 1
+        proposals = []
+        for strategy, params in zip(strategies, self.space.to_params(points)):
+            proposal = Proposal(str(uuid.uuid4()), self._complete(params), strategy, dict(meta))
+            self.pending[proposal.experiment_id] = proposal
+            proposals.append(proposal)
+        return proposals
+
+    def with_observations(self, observations: Sequence[Mapping[str, Any]] | None = None, draw: int = 0
+                          ) -> BasePlanner:
+        """A fresh planner of the same config, seed and known constraints that knows exactly `observations` and has
+        nothing pending (the feasible-set estimate is shared, not recomputed). `draw` (>= 0) picks another set of
+        random draws for the same observations: draw k makes the draws of a planner that has been asked k times."""
+        if isinstance(draw, bool) or not isinstance(draw, (int, np.integer)) or draw < 0:
+            raise ValueError(f"draw must be a non-negative integer, got {draw!r}")
+        fresh = type(self)(self.config, self._known_constraints, self.seed)
+        fresh.region = self.region  # the same constraints: V_C and the feasible set are not computed again
+        if observations:
+            fresh.tell(list(observations))
+        fresh._ask_count = int(draw)
+        return fresh
+
+    def recommend(self, observations: Sequence[Mapping[str, Any]] | None = None,
+                  sampling_strategies: Sequence[float] | None = None, num_batches: int | None = None,
+                  draw: int = 0) -> list[dict[str, Any]]:
+        """Gryffin-compatible and stateless: parameter dicts for the given observations, `num_batches` batches
+        (default general.batches) of one proposal per sampling strategy, batch by batch. `sampling_strategies`
+        (values s, +1 exploit, -1 explore) replace the config's for this call; `draw` as in `with_observations`."""
+        general = self.config.general
+        fresh = self.with_observations(observations, draw)
+        count = general.sampling_strategies
+        if sampling_strategies is not None:
+            values = np.atleast_1d(np.asarray(sampling_strategies, dtype=float))
+            if values.ndim != 1 or not len(values) or not np.all(np.isfinite(values)):
+                raise ValueError(f"sampling_strategies must be a non-empty list of finite numbers, got "
+                                 f"{sampling_strategies!r}")
+            fresh._strategies, count = values, len(values)
+        batches = general.batches if num_batches is None else num_batches
+        if isinstance(batches, bool) or not isinstance(batches, (int, np.integer)) or batches < 1:
+            raise ValueError(f"num_batches must be a positive integer, got {num_batches!r}")
+        return [p.params for p in fresh.ask(int(batches) * count)]
+
+    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
+        """n internal points, the sampling strategy of each and what every proposal of this ask records in meta."""
+        raise NotImplementedError
+
+    # ---- persistence -----------------------------------------------------------------------------------------
+    def state(self) -> dict[str, Any]:
+        """A JSON-serializable snapshot; ``from_state`` rebuilds an identical planner (pass callables again)."""
+        return {
+            "format": STATE_FORMAT, "strategy": type(self).__name__, "config": self.config.raw, "seed": self.seed,
+            "observations": [o.to_dict() for o in self.observations],
+            "pending": [p.to_dict() for p in self.pending.values()],
+            "ask_count": self._ask_count, "proposal_count": self._proposal_count,
+        }
+
+    @classmethod
+    def from_state(cls, state: Mapping[str, Any], known_constraints: ConstraintArg = None,
+                   base_dir: str | Path | None = None) -> BasePlanner:
+        """Rebuild a planner from `state()`; `base_dir` resolves relative file names in its config."""
+        if not isinstance(state, Mapping) or state.get("format") != STATE_FORMAT:
+            raise ConfigError(f"not a planner state of format {STATE_FORMAT}")
+        if state.get("strategy") != cls.__name__:
+            raise ConfigError(f"state was saved by {state.get('strategy')!r}, not {cls.__name__}")
+        planner = cls(load_config(state["config"], base_dir), known_constraints, state["seed"])
+        planner.restore([planner.parse_observation(o) for o in state["observations"]],
+                        [Proposal(p["experiment_id"], p["params"], p.get("strategy"), dict(p.get("meta") or {}))
+                         for p in state["pending"]],
+                        state["ask_count"], state["proposal_count"])
+        return planner

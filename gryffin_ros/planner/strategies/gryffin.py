@@ -1,0 +1,248 @@
+"""The constrained kernel-density Planner of the paper (Gryffin with known constraints), with the GP surrogate
+beside it: models of one ask, start points, candidates from the acquisition optimizer, diversity-aware selection."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import torch
+
+from ..acquisition.kernel import Acquisition
+from ..config import PlannerConfig
+from ..constraints.sampling import perturb, rejection_sample, spread_seeds
+from ..domain import ConstraintArg, Observation
+from ..optimizers import AcquisitionOptimizer, make_optimizer
+from ..surrogates.choice import SurrogateChoice
+from ..surrogates.descriptors import LearnedDescriptors, learn_many
+from ..surrogates.feasibility import FeasibilityModel, combine
+from ..surrogates.kernel_density import KernelDensity
+from .base import BasePlanner
+from .feasible import SPREAD_SEEDS
+from .selection import select
+
+if TYPE_CHECKING:  # the GP module (and BoTorch, ~0.4 s to import) is loaded only by planners that use it
+    from ..surrogates.gaussian_process import GaussianProcess, GPAcquisition
+
+# general.kernel_width = spacing: continuous kernels of precision SPACING_FACTOR * rho^(2/C), a quarter of the typical
+# spacing of the data wide (measured on the paper's continuous benchmarks: factors 4-32 all beat Gryffin's 12 rho^2,
+# whose kernels are so narrow that the acquisition is flat between observations; docs/departures.md "Kernel width").
+# `auto` uses them up to AUTO_SPACING_MAX_DIMS continuous dims and Gryffin's above, where kernels that wide overlap
+# everywhere and every candidate needs every kernel (n = 1000, d = 10: 1.4 s per ask instead of 0.2 s).
+SPACING_FACTOR = 16.0
+AUTO_SPACING_MAX_DIMS = 4
+# Start points: hit-and-run chains from known feasible points, at least WALK_POINTS_PER_SEED points each.
+WALK_POINTS_PER_SEED = 8
+
+
+@dataclass
+class Surrogates:
+    """The models of one ask of the kernel-density Planner (`Planner.surrogates()`)."""
+
+    successful: list[Observation]  # the successful experiments, in order
+    X: np.ndarray  # their points, internal units
+    merits: np.ndarray  # their merits after general.obj_transform (0 best): what the kernels regress
+    descriptors: dict[int, np.ndarray]  # learned descriptor tables by finite dim (general.auto_desc_gen)
+    density: KernelDensity | None  # None before the first successful experiment
+    feasibility: FeasibilityModel | None  # None until an experiment has failed
+
+
+class Planner(BasePlanner):
+    """Gryffin with known constraints: kernel-density surrogate, lambda strategies, constrained Adam+Hill or genetic
+    acquisition optimization, diversity-aware selection; or (general.surrogate) a Gaussian process under the same
+    constrained optimizers, or the better ranking of the two on the data so far."""
+
+    def __init__(self, config: Mapping | str | Path | PlannerConfig, known_constraints: ConstraintArg = None,
+                 seed: int | None = None):
+        super().__init__(config, known_constraints, seed)
+        self.surrogate_choice = SurrogateChoice(self.config.general.surrogate, self.space, self.seed,
+                                                lambda observations: self.merits(observations, transform=False))
+
+    def strategy_values(self) -> np.ndarray:
+        """Sampling strategies s, from exploitation (+1) to exploration (-1); a single strategy is s = 0 (or those
+        given to `recommend`)."""
+        if self._strategies is not None:
+            return self._strategies.copy()
+        count = self.config.general.sampling_strategies
+        return np.linspace(1.0, -1.0, count) if count > 1 else np.zeros(1)
+
+    @property
+    def spacing_kernels(self) -> bool:
+        """Whether continuous kernels are spacing-scaled (general.kernel_width; `auto`: up to 4 continuous dims)."""
+        width = self.config.general.kernel_width
+        return width == "spacing" or (width == "auto" and len(self.space.cont_idx) <= AUTO_SPACING_MAX_DIMS)
+
+    def optimizer(self) -> AcquisitionOptimizer:
+        """The acquisition optimizer general.acquisition_optimizer names."""
+        return make_optimizer(self.config.general.acquisition_optimizer, self.constraints)
+
+    def start_points(self, rng: np.random.Generator, incumbent: np.ndarray, feasible_observed: np.ndarray
+                      ) -> tuple[np.ndarray, bool]:
+        """Start points and whether they are the whole feasible set (then no local refinement is needed)."""
+        feasible = self.feasible_set()
+        if feasible is not None:
+            return feasible, True
+        m = self.config.general.num_random_samples * self.space.dim
+        uniform = rejection_sample(self.constraints, rng, m, self.config.general.max_rejection_draws,
+                                   self.feasible_fraction.value)
+        # hit-and-run chains from spread-out known feasible points: they fill in when uniform draws are rare (tiny
+        # feasible sets) and give every separate feasible region found a share of start points, however small
+        walked = np.empty((0, self.space.dim))
+        if self.constraints:
+            seeds = spread_seeds(self.space, self.feasible_pool(), SPREAD_SEEDS, rng)
+            walked = self.region.walk(self.constraints, rng, seeds,
+                                 max(m - len(uniform), WALK_POINTS_PER_SEED * len(seeds)))
+        start = np.concatenate([uniform, walked, perturb(self.constraints, rng, incumbent, m)])
+        if len(uniform) < m:
+            start = np.concatenate([start, feasible_observed])
+        return start, False
+
+    def learned_descriptors(self, X: np.ndarray, target: np.ndarray) -> dict[int, LearnedDescriptors]:
+        """Dynamic descriptors for each categorical dim with several descriptors (general.auto_desc_gen)."""
+        if not self.config.general.auto_desc_gen:
+            return {}
+        tables = {int(d): self.space.descriptors(d) for d in self.space.finite_idx
+                  if self.space.parameters[d].kind == "categorical"}
+        dims = [d for d, table in tables.items() if table is not None and table.shape[1] > 1]
+        results = learn_many([(tables[d], X[:, d].astype(int)) for d in dims], target)
+        return {d: result for d, result in zip(dims, results) if result is not None}
+
+    def descriptor_summary(self) -> dict[str, dict[str, Any]]:
+        """What dynamic descriptors learned from the current data, per categorical parameter: for the objective
+        model and for the failure model, the relevance of each original descriptor (shares summing to 1) and the
+        correlation of each generated descriptor with its target (kept when above 1/sqrt(N - 2))."""
+        successful = [o for o in self.observations if not o.failed]
+        observed = self.observed_points()
+        models = {"objective": self.learned_descriptors(self._internal([o.params for o in successful]),
+                                                        self.merits(successful)) if successful else {},
+                  "feasibility": self.learned_descriptors(observed, np.array([float(o.failed)
+                                                                              for o in self.observations]))}
+        summary: dict[str, dict[str, Any]] = {}
+        for target, learned in models.items():
+            for d, result in learned.items():
+                summary.setdefault(self.space.names[d], {})[target] = {
+                    "relevance": result.relevance.round(4).tolist(),
+                    "correlations": result.correlations.round(4).tolist(), "kept": result.kept.tolist()}
+        return summary
+
+    def _feasibility(self, observed: np.ndarray, generator: torch.Generator) -> FeasibilityModel | None:
+        """The model of unknown constraints, once some experiment has failed."""
+        failed = np.array([o.failed for o in self.observations])
+        if not failed.any():
+            return None
+        descriptors = {d: r.table for d, r in self.learned_descriptors(observed, failed.astype(float)).items()}
+        return FeasibilityModel(self.space, observed, failed, self.feasible_fraction.value, generator, descriptors)
+
+    def _away_from_failures(self, n: int, rng: np.random.Generator, observed: np.ndarray, chosen: np.ndarray,
+                            feasibility: FeasibilityModel) -> np.ndarray:
+        """Nothing has succeeded yet: the feasible candidates most likely to succeed, spread out."""
+        candidates = self.feasible_set()
+        if candidates is None:
+            m = self.config.general.num_random_samples * self.space.dim
+            candidates = rejection_sample(self.constraints, rng, m, self.config.general.max_rejection_draws,
+                                          self.feasible_fraction.value)
+        score = -feasibility.probability(candidates) if len(candidates) else np.empty(0)
+        points = []
+        for _ in range(n):
+            index = (select(self.space, candidates, score, observed, chosen, dist_param=self.config.general.dist_param)
+                     if len(candidates) else None)
+            x = candidates[index] if index is not None else self.random_points(
+                1, rng, np.concatenate([observed, chosen]))[0]
+            chosen = np.concatenate([chosen, x[None]])
+            points.append(x)
+        return np.array(points)
+
+    def _surrogates(self, generator: torch.Generator) -> Surrogates:
+        """The failure model, then (with a successful experiment) the kernel density of the merits, in that order of
+        draws from `generator`."""
+        successful = [o for o in self.observations if not o.failed]
+        feasibility = self._feasibility(self.observed_points(), generator)
+        if not successful:
+            return Surrogates(successful, np.empty((0, self.space.dim)), np.empty(0), {}, None, feasibility)
+        X = self._internal([o.params for o in successful])
+        merits = self.merits(successful)
+        descriptors = {d: r.table for d, r in self.learned_descriptors(X, merits).items()}
+        density = KernelDensity(self.space, X, merits, self.feasible_fraction.value, generator,
+                                spacing_scaled=self.spacing_kernels, spacing_factor=SPACING_FACTOR,
+                                descriptors=descriptors, temperature_scale=self.config.general.concrete_temperature)
+        return Surrogates(successful, X, merits, descriptors, density, feasibility)
+
+    def surrogates(self) -> Surrogates:
+        """The kernel density and the failure model that the next ask() builds, with the same draws (for
+        inspection: regression, P(feasible), acquisition; the GP of general.surrogate is not among them)."""
+        rng = self._rng()
+        return self._surrogates(torch.Generator().manual_seed(int(rng.integers(2**63))))
+
+    def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
+        observed = self.observed_points()
+        chosen = self.pending_points()
+        generator = torch.Generator().manual_seed(int(rng.integers(2**63)))
+        models = self._surrogates(generator)
+        successful = models.successful
+        feasibility = models.feasibility
+        if models.density is None:
+            if feasibility is None:
+                return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n, {}
+            return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n, {}
+        X, merits, descriptors, density = models.X, models.merits, models.descriptors, models.density
+        gp, meta = self.surrogate_choice.choose(X, merits, successful, density, descriptors)
+        start, exhaustive = self.start_points(rng, X[int(np.argmin(merits))], X)
+        if gp is not None:
+            return self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen), [None] * n, meta
+        values = self.strategy_values()
+        optimizer = self.optimizer()
+        refined: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        points, strategies = [], []
+        for _ in range(n):
+            s = float(values[self._proposal_count % len(values)])
+            self._proposal_count += 1
+            if s not in refined:
+                refined[s] = self._candidates(Acquisition(density, s), start, exhaustive, optimizer, rng,
+                                              feasibility)
+            candidates, alpha = refined[s]
+            index = (select(self.space, candidates, alpha, observed, chosen, dist_param=self.config.general.dist_param)
+                     if len(candidates) else None)
+            x = candidates[index] if index is not None else self.random_points(
+                1, rng, np.concatenate([observed, chosen]))[0]
+            chosen = np.concatenate([chosen, x[None]])
+            points.append(x)
+            strategies.append(s)
+        return np.array(points), strategies, meta
+
+    def _candidates(self, acquisition: Acquisition | GPAcquisition, start: np.ndarray, exhaustive: bool,
+                    optimizer: AcquisitionOptimizer, rng: np.random.Generator,
+                    feasibility: FeasibilityModel | None) -> tuple[np.ndarray, np.ndarray]:
+        """Optimized feasible candidates and their scores (acquisition combined with P(feasible) once experiments
+        have failed); the whole feasible set, scored, when it is small enough."""
+        if exhaustive:
+            candidates, alpha = start, acquisition.evaluate(start)
+        else:
+            candidates, alpha = optimizer.optimize(acquisition, start, rng)
+            keep = self.constraints.feasible(candidates)  # guaranteed by the optimizers; never trusted blindly
+            candidates, alpha = candidates[keep], alpha[keep]
+        if feasibility is not None:
+            general = self.config.general
+            alpha = combine(alpha, feasibility.probability(candidates), general.feas_approach, general.feas_param,
+                            feasibility.fraction_failed)
+        return candidates, alpha
+
+    def _propose_gp(self, n: int, rng: np.random.Generator, gp: GaussianProcess, start: np.ndarray, exhaustive: bool,
+                    feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray) -> np.ndarray:
+        """n points by the GP's expected improvement; pending experiments and the batch's earlier proposals enter the
+        GP as believed results (kriging believer), so a batch spreads out without Gryffin's strategies."""
+        gp.believe(chosen)
+        optimizer = self.optimizer()
+        points = []
+        for i in range(n):
+            candidates, alpha = self._candidates(gp.acquisition(), start, exhaustive, optimizer, rng, feasibility)
+            index = select(self.space, candidates, alpha, observed, chosen, diverse=False) if len(candidates) else None
+            x = candidates[index] if index is not None else self.random_points(
+                1, rng, np.concatenate([observed, chosen]))[0]
+            chosen = np.concatenate([chosen, x[None]])
+            points.append(x)
+            if i + 1 < n:
+                gp.believe(x[None])
+        return np.array(points)

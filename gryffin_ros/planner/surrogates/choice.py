@@ -1,0 +1,84 @@
+"""general.surrogate: which regression model the next proposals come from — the paper's kernel density (`kde`), a
+Gaussian process (`gp`), or the better ranking of the two on the data so far (`auto`) — with the GP's fitted
+hyperparameters cached between asks."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..domain import Observation
+from ..space import SearchSpace
+from .kernel_density import KernelDensity
+
+if TYPE_CHECKING:  # BoTorch (~0.4 s to import) is loaded only when a GP is used
+    from .gaussian_process import GaussianProcess
+
+SURROGATES = ("kde", "gp", "auto")
+# `auto` compares the GP with the kernel density once the successful experiments have this many distinct results.
+AUTO_MIN_OBSERVATIONS = 5
+
+
+class SurrogateChoice:
+    """Chooses the surrogate of each ask. `raw_merits(observations)` gives the untransformed merits of successful
+    observations (what the GP regresses: a square root would put a cusp at the optimum)."""
+
+    def __init__(self, setting: str, space: SearchSpace, seed: int,
+                 raw_merits: Callable[[Sequence[Observation]], np.ndarray]):
+        if setting not in SURROGATES:
+            raise ValueError(f"unknown surrogate {setting!r}; choose one of {SURROGATES}")
+        self.setting, self.space, self.seed, self.raw_merits = setting, space, seed, raw_merits
+        self._gp_fit: tuple[int, dict] | None = None  # (observations fitted, GP hyperparameters) of the last fit
+        if setting != "kde":
+            from .gaussian_process import require_botorch
+            require_botorch()
+
+    def gaussian_process(self, X: np.ndarray, successful: Sequence[Observation],
+                         descriptors: Mapping[int, np.ndarray]) -> GaussianProcess:
+        """The GP of the untransformed merits, conditioned on every successful experiment, with hyperparameters
+        fitted to the first `fit_size(n)` of them (cached; learned descriptors change with every observation, so with
+        them every ask fits). Fits are seeded by the campaign seed and their size alone, so they never change the
+        draws of the rest of the ask."""
+        from .gaussian_process import GaussianProcess, fit_size
+
+        def seed(size: int) -> int:
+            return int(np.random.default_rng([self.seed, size, 3]).integers(2**62))
+
+        size = len(X) if descriptors else fit_size(len(X))
+        hyperparameters = self._gp_fit[1] if self._gp_fit and self._gp_fit[0] == size else None
+        if hyperparameters is None and size < len(X):
+            hyperparameters = GaussianProcess(self.space, X[:size], self.raw_merits(successful[:size]),
+                                              seed(size)).hyperparameters
+        gp = GaussianProcess(self.space, X, self.raw_merits(successful), seed(size), descriptors, hyperparameters)
+        if not descriptors:
+            self._gp_fit = (size, gp.hyperparameters)
+        return gp
+
+    def choose(self, X: np.ndarray, merits: np.ndarray, successful: Sequence[Observation], density: KernelDensity,
+               descriptors: Mapping[int, np.ndarray]) -> tuple[GaussianProcess | None, dict[str, Any]]:
+        """The GP (or None for the kernel density) and what the proposals record about the choice.
+
+        `auto` compares the two models on the data so far by the rank correlation of their leave-one-out predictions
+        with the observed merits (what the acquisition needs is the ordering of points, not calibrated values). The
+        GP, which departs from the paper, is used only when it ranks better by more than the sampling error of the
+        score (Fisher z of Spearman's r, s.e. sqrt(1.06 / (m - 3))), m the number of distinct merits: tied results
+        carry no ranking, so on plateaus (a step-shaped surface with a few levels) the score says little and the
+        kernel density stays; never with fewer than AUTO_MIN_OBSERVATIONS distinct merits."""
+        if self.setting == "kde":
+            return None, {"surrogate": "kde"}
+        if self.setting == "gp":
+            return self.gaussian_process(X, successful, descriptors), {"surrogate": "gp"}
+        levels = len(np.unique(merits))
+        if levels < AUTO_MIN_OBSERVATIONS:
+            return None, {"surrogate": "kde", "surrogate_reason": f"auto: fewer than {AUTO_MIN_OBSERVATIONS} "
+                          "distinct successful results"}
+        from .gaussian_process import rank_correlation
+        gp = self.gaussian_process(X, successful, descriptors)
+        scores = {"kde": round(rank_correlation(density.leave_one_out(), merits), 4),
+                  "gp": round(rank_correlation(gp.leave_one_out(), merits), 4)}
+        z = {name: math.atanh(min(max(r, -0.999), 0.999)) for name, r in scores.items()}
+        chosen = "gp" if z["gp"] - z["kde"] > math.sqrt(1.06 / (levels - 3)) else "kde"
+        return (gp if chosen == "gp" else None), {"surrogate": chosen, "loo_rank_correlation": scores}

@@ -1,0 +1,67 @@
+"""Unknown constraints learned from failed experiments: P(feasible | x) from the kernel densities of successful and
+failed observations, and its combination with the acquisition (fwa, fia, fca).
+
+Two kernel estimates, each P = (sum_{k ok} p_k(x) + prior * u) / (sum_k p_k(x) + u), u = 1/V the uniform density
+acting as one prior pseudo-observation. The wide one (kernels as broad as the spacing of the data, descriptors
+shared between options) has the constant prior pi = (n_ok + 1) / (n + 2); the narrow one (Gryffin's kernels, each
+option on its own) has the wide estimate as its prior. Near observations the narrow kernels decide, between them
+the wide ones extend what was seen, far from everything P = pi. Each estimate is 1 - alpha of the kernel
+acquisition with the failure labels as merits, so the same numerics (log space, no underflow) serve both.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import torch
+
+from ..acquisition.kernel import Acquisition
+from ..space import SearchSpace
+from .kernel_density import KernelDensity
+
+APPROACHES = ("fwa", "fia", "fca")
+FCA_MIN_PASSING = 0.1
+
+
+def no_descriptors(space: SearchSpace) -> dict[int, None]:
+    """Descriptor overrides that make every finite dim's kernel treat each option on its own."""
+    return {int(d): None for d in space.finite_idx}
+
+
+class FeasibilityModel:
+    def __init__(self, space: SearchSpace, X: np.ndarray, failed: np.ndarray, feasible_fraction: float,
+                 generator: torch.Generator, descriptors: Mapping[int, np.ndarray] | None = None):
+        self.fraction_failed = float(failed.mean())
+        self.prior = (len(failed) - failed.sum() + 1.0) / (len(failed) + 2.0)
+        labels = failed.astype(float)
+        self._wide = Acquisition(KernelDensity(space, X, labels, feasible_fraction, generator, spacing_scaled=True,
+                                               descriptors=descriptors), 1.0 - self.prior)
+        narrow = KernelDensity(space, X, labels, feasible_fraction, generator, descriptors=no_descriptors(space))
+        self._narrow = (Acquisition(narrow, 0.0), Acquisition(narrow, 1.0))
+
+    def probability(self, X: np.ndarray) -> np.ndarray:
+        """(M, D) internal points -> (M,) P(feasible): Gryffin's narrow kernels, each option on its own, with the
+        wide estimate (kernels as wide as the data spacing, descriptors shared) as their prior instead of a constant:
+        near observations the narrow kernels decide, elsewhere the wide ones extend what was seen."""
+        prior = 1.0 - self._wide.evaluate(X)
+        alpha0, alpha1 = (a.evaluate(X) for a in self._narrow)  # S_fail/(S+u) and (S_fail+u)/(S+u)
+        return 1.0 - alpha0 - (1.0 - prior) * (alpha1 - alpha0)
+
+
+def combine(alpha: np.ndarray, p_feasible: np.ndarray, approach: str, feas_param: float,
+            fraction_failed: float) -> np.ndarray:
+    """The score to minimize over a candidate set, from alpha and P(feasible). alpha is first rescaled to a in [0, 1]
+    over the set. fwa: -(1 - a) P. fia: w (1 - P) + (1 - w) a, w = fraction_failed^feas_param. fca: a where
+    P > threshold (feas_param, halved until at least 10 % of the candidates pass), +inf elsewhere."""
+    span = alpha.max() - alpha.min()
+    a = (alpha - alpha.min()) / span if span > 0 else np.zeros_like(alpha)
+    if approach == "fwa":
+        return -(1.0 - a) * p_feasible
+    if approach == "fia":
+        w = fraction_failed ** feas_param
+        return w * (1.0 - p_feasible) + (1.0 - w) * a
+    threshold = feas_param
+    while (p_feasible > threshold).mean() < FCA_MIN_PASSING and threshold > 1e-6:
+        threshold *= 0.5
+    return np.where(p_feasible > threshold, a, np.inf)

@@ -1,0 +1,238 @@
+"""The Gaussian-process surrogate (general.surrogate = gp), built on BoTorch/GPyTorch: an exact GP with a Matern-5/2
+ARD kernel on normalized inputs, standardized outputs and hyperparameters by marginal likelihood, and its log expected
+improvement as an acquisition that the planner's constrained optimizers (Adam/Hill, genetic) minimize like Gryffin's.
+
+Inputs: continuous dims as they are inside the planner ([0, 1]; periodic ones as a point on a circle), discrete dims
+at their ordinal positions in [0, 1], categorical dims through their descriptors (static or learned, each column
+scaled to [0, 1]) or, without descriptors, as categories (BoTorch's mixed categorical kernel).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping
+from functools import partial
+
+import numpy as np
+import torch
+
+from ..errors import ConfigError
+from ..space import SearchSpace
+from .kernel_density import split
+
+DTYPE = torch.float64
+# Noise floor (variance, standardized units): low enough that a noiseless objective is interpolated closely near its
+# optimum, where regrets of 1e-3 of the range are asked for; GPyTorch's default floor (1e-4) blurs that.
+MIN_NOISE = 1e-6
+# Kernel length scales (inputs in [0, 1]) and output scale (outputs standardized) are fitted within these bounds.
+LENGTHSCALE_BOUNDS = (1e-3, 20.0)
+OUTPUTSCALE_BOUNDS = (1e-3, 100.0)
+# Largest number of candidates in one posterior evaluation.
+CHUNK = 4096
+
+try:
+    from botorch.acquisition import LogExpectedImprovement
+    from botorch.exceptions import ModelFittingError
+    from botorch.fit import fit_gpytorch_mll
+    from botorch.models import MixedSingleTaskGP, SingleTaskGP
+    from botorch.models.transforms.outcome import Standardize
+    from botorch.models.utils.gpytorch_modules import (
+        get_gaussian_likelihood_with_lognormal_prior,
+    )
+    from gpytorch.constraints import GreaterThan, Interval
+    from gpytorch.kernels import MaternKernel, ScaleKernel
+    from gpytorch.mlls import ExactMarginalLogLikelihood
+    from gpytorch.utils.warnings import NumericalWarning
+except ImportError as _error:  # the GP is an extra: `pip install gryffin_ros[gp]`
+    _IMPORT_ERROR: ImportError | None = _error
+else:
+    _IMPORT_ERROR = None
+
+
+def require_botorch() -> None:
+    """Raise a ConfigError that says how to install the GP's libraries when they are missing."""
+    if _IMPORT_ERROR is not None:
+        raise ConfigError(f"general.surrogate 'gp'/'auto' needs BoTorch (pip install 'gryffin_ros[gp]'): "
+                          f"{_IMPORT_ERROR}")
+
+
+class Features:
+    """Planner points (M, D) -> GP inputs (M, G) in [0, 1], differentiable in the continuous coordinates."""
+
+    def __init__(self, space: SearchSpace, descriptors: Mapping[int, np.ndarray] | None = None):
+        self.space = space
+        self.columns: list[tuple[str, int, torch.Tensor | None]] = []  # (kind, position in xc/xf, lookup table)
+        for j, d in enumerate(space.cont_idx):
+            self.columns.append(("periodic" if space.periodic[d] else "continuous", j, None))
+        for j, d in enumerate(space.finite_idx):
+            table = (descriptors or {}).get(int(d), space.descriptors(int(d)))
+            if table is None:
+                self.columns.append(("category", j, None))
+                continue
+            table = np.asarray(table, dtype=float)
+            span = table.max(axis=0) - table.min(axis=0)
+            useful = span > 0
+            if not useful.any():  # descriptors that cannot tell the options apart: the options themselves
+                self.columns.append(("category", j, None))
+                continue
+            scaled = (table[:, useful] - table.min(axis=0)[useful]) / span[useful]
+            self.columns.append(("table", j, torch.as_tensor(scaled, dtype=DTYPE)))
+        parts = [1 if kind in ("continuous", "category") else (2 if kind == "periodic" else len(table.T))
+                 for kind, _, table in self.columns]
+        offsets = np.cumsum([0] + parts)
+        self.dim = int(offsets[-1])
+        self.cat_dims = [int(offsets[i]) for i, (kind, _, _) in enumerate(self.columns) if kind == "category"]
+
+    def __call__(self, xc: torch.Tensor, xf: torch.Tensor) -> torch.Tensor:
+        """xc: (M, C) continuous coordinates (may require grad), xf: (M, F) long option indices -> (M, G)."""
+        out = []
+        for kind, j, table in self.columns:
+            if kind == "continuous":
+                out.append(xc[:, j:j + 1])
+            elif kind == "periodic":
+                angle = 2 * math.pi * xc[:, j:j + 1]
+                out += [0.5 + 0.5 * torch.sin(angle), 0.5 + 0.5 * torch.cos(angle)]
+            elif kind == "category":
+                out.append(xf[:, j:j + 1].to(DTYPE))
+            else:
+                out.append(table[xf[:, j]])
+        return torch.cat(out, dim=1)
+
+    def of(self, X: np.ndarray) -> torch.Tensor:
+        """(M, D) internal points -> (M, G) inputs."""
+        return self(*split(self.space, X))
+
+
+def fit_size(n: int) -> int:
+    """How many of the first n observations the hyperparameters are fitted to: all of them up to 19, then the
+    largest multiple of n // 10 (a refit every 2nd observation at 20, every 10th at 100). In between, the GP keeps
+    the last fit's hyperparameters and is conditioned on all the data; a fit is the costly part of an ask, and a
+    restarted planner refits exactly the same hyperparameters from the same first observations."""
+    step = max(1, n // 10)
+    return n - n % step
+
+
+class GaussianProcess:
+    """An exact GP fitted to (X, y), y minimized: hyperparameters by marginal likelihood (seeded random restarts,
+    if BoTorch needs any), or given (`hyperparameters` of an earlier fit to part of the same campaign)."""
+
+    def __init__(self, space: SearchSpace, X: np.ndarray, y: np.ndarray, seed: int,
+                 descriptors: Mapping[int, np.ndarray] | None = None,
+                 hyperparameters: Mapping[str, torch.Tensor] | None = None):
+        require_botorch()
+        self.space = space
+        self.features = Features(space, descriptors)
+        self.best = float(np.min(y))
+        train_X = self.features.of(X).detach()
+        train_Y = torch.as_tensor(np.asarray(y, dtype=float)[:, None], dtype=DTYPE)
+        likelihood = get_gaussian_likelihood_with_lognormal_prior()
+        likelihood.noise_covar.register_constraint("raw_noise", GreaterThan(MIN_NOISE))
+        # ARD Matern-5/2 without hyperpriors: the marginal likelihood alone, as in GPyOpt, within bounds that keep a
+        # smooth trend (a quadratic bowl, a slope) from pushing length and output scales to infinity
+        matern = partial(MaternKernel, nu=2.5, lengthscale_constraint=Interval(*LENGTHSCALE_BOUNDS))
+        if self.features.cat_dims:
+            self.model = MixedSingleTaskGP(train_X, train_Y, cat_dims=self.features.cat_dims, likelihood=likelihood,
+                                           cont_kernel_factory=matern, outcome_transform=Standardize(m=1))
+        else:
+            self.model = SingleTaskGP(train_X, train_Y, likelihood=likelihood,
+                                      covar_module=ScaleKernel(matern(ard_num_dims=self.features.dim),
+                                                               outputscale_constraint=Interval(*OUTPUTSCALE_BOUNDS)),
+                                      outcome_transform=Standardize(m=1))
+        if hyperparameters is not None:
+            self.model.load_state_dict(dict(hyperparameters), strict=False)
+        else:
+            initial = self.hyperparameters
+            with torch.random.fork_rng(), warnings.catch_warnings():
+                torch.manual_seed(seed)
+                warnings.simplefilter("ignore")  # BoTorch's notes on fit retries and input scaling: handled here
+                try:
+                    fit_gpytorch_mll(ExactMarginalLogLikelihood(self.model.likelihood, self.model))
+                except ModelFittingError:
+                    # no attempt converged; the last one's point is kept when it is a usable model, else the start
+                    if not all(torch.isfinite(v).all() for v in self.hyperparameters.values()):
+                        self.model.load_state_dict(initial, strict=False)
+        self.model.eval()
+
+    @property
+    def hyperparameters(self) -> dict[str, torch.Tensor]:
+        """Kernel, noise and mean parameters (not the output standardization, which belongs to the data)."""
+        return {k: v.detach().clone() for k, v in self.model.state_dict().items()
+                if not k.startswith("outcome_transform")}
+
+    def leave_one_out(self) -> np.ndarray:
+        """(n,) leave-one-out predictive means of the training targets, with the fitted hyperparameters
+        (Rasmussen & Williams eq. 5.12), in standardized units."""
+        model = self.model
+        with torch.no_grad():
+            X = model.train_inputs[0]
+            K = model.covar_module(X).to_dense() + model.likelihood.noise * torch.eye(len(X), dtype=DTYPE)
+            residual = model.train_targets - model.mean_module(X)
+            K_inv = torch.cholesky_inverse(torch.linalg.cholesky(K))
+            alpha = K_inv @ residual
+            return (model.train_targets - alpha / torch.diagonal(K_inv)).numpy()
+
+    def believe(self, X: np.ndarray) -> None:
+        """Kriging believer: condition the GP on its own posterior mean at points whose results are not known yet
+        (pending experiments, earlier proposals of this batch), so they are not proposed again."""
+        if not len(X):
+            return
+        inputs = self.features.of(X)
+        with torch.no_grad():
+            mean = self.model.posterior(inputs).mean
+        self.model = self.model.condition_on_observations(inputs, mean)
+        self.model.eval()
+
+    def acquisition(self) -> GPAcquisition:
+        return GPAcquisition(self)
+
+
+class GPAcquisition:
+    """alpha(x) = -log EI(x) of the GP against the best observation: the same interface as the kernel acquisition
+    (`evaluate`, `value_and_grad`), so Adam/Hill and the genetic optimizer minimize it under the known constraints."""
+
+    def __init__(self, gp: GaussianProcess):
+        self.space = gp.space
+        self.features = gp.features
+        self.log_ei = LogExpectedImprovement(gp.model, best_f=gp.best, maximize=False)
+
+    def _alpha(self, xc: torch.Tensor, xf: torch.Tensor) -> torch.Tensor:
+        with warnings.catch_warnings():
+            # GPyTorch rounds variances that come out slightly negative (at observed points) up to 1e-10 and says so
+            warnings.simplefilter("ignore", NumericalWarning)
+            return -self.log_ei(self.features(xc, xf)[:, None, :])
+
+    def evaluate(self, X: np.ndarray) -> np.ndarray:
+        """alpha at (M, D) internal points."""
+        xc, xf = split(self.space, X)
+        with torch.no_grad():
+            return np.concatenate([self._alpha(xc[i:i + CHUNK], xf[i:i + CHUNK]).numpy()
+                                   for i in range(0, len(X), CHUNK)]) if len(X) else np.empty(0)
+
+    def value_and_grad(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """alpha (M,) and its gradient w.r.t. the continuous internal coordinates (M, C), by autograd."""
+        xc, xf = split(self.space, X)
+        alpha, grad = np.empty(len(X)), np.zeros(xc.shape)
+        for i in range(0, len(X), CHUNK):
+            leaf = xc[i:i + CHUNK].clone().requires_grad_(bool(xc.shape[1]))
+            value = self._alpha(leaf, xf[i:i + CHUNK])
+            if xc.shape[1]:
+                (g,) = torch.autograd.grad(value.sum(), leaf)
+                grad[i:i + CHUNK] = g.numpy()
+            alpha[i:i + CHUNK] = value.detach().numpy()
+        return alpha, grad
+
+
+def rank_correlation(a: np.ndarray, b: np.ndarray) -> float:
+    """Spearman's rank correlation (average ranks for ties); 0 when either side is constant."""
+    def ranks(v: np.ndarray) -> np.ndarray:
+        order = np.argsort(v, kind="stable")
+        r = np.empty(len(v))
+        r[order] = np.arange(len(v), dtype=float)
+        _, group = np.unique(v, return_inverse=True)
+        return (np.bincount(group, weights=r) / np.bincount(group))[group]
+
+    ra, rb = ranks(np.asarray(a, dtype=float)), ranks(np.asarray(b, dtype=float))
+    ra, rb = ra - ra.mean(), rb - rb.mean()
+    denominator = math.sqrt(float((ra ** 2).sum() * (rb ** 2).sum()))
+    return float((ra * rb).sum() / denominator) if denominator > 0 else 0.0

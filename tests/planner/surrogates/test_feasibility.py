@@ -1,0 +1,82 @@
+"""Failed experiments as unknown constraints: the classifier, its combination with the acquisition, and a campaign
+that learns to avoid a region it was never told about."""
+
+import numpy as np
+import pytest
+import torch
+
+from gryffin_ros.planner import Planner
+from gryffin_ros.planner.surrogates.feasibility import FeasibilityModel, combine
+
+SQUARE = {"parameters": [{"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0},
+                         {"name": "x1", "type": "continuous", "low": 0.0, "high": 1.0}],
+          "objectives": [{"name": "y", "goal": "min"}]}
+
+
+def model(X, failed):
+    planner = Planner(SQUARE, seed=0)
+    return FeasibilityModel(planner.space, np.asarray(X, float), np.asarray(failed), 1.0,
+                            torch.Generator().manual_seed(0))
+
+
+def test_probability_is_low_near_failures_high_near_successes_and_the_prior_far_away():
+    rng = np.random.default_rng(0)
+    bad = rng.uniform(0.0, 0.2, (8, 2))
+    good = rng.uniform(0.8, 1.0, (8, 2))
+    m = model(np.concatenate([bad, good]), [True] * 8 + [False] * 8)
+    p_bad, p_good = m.probability(np.array([[0.1, 0.1]]))[0], m.probability(good[:1])[0]
+    p_far = m.probability(np.array([[0.1, 0.9]]))[0]
+    assert p_bad < 0.2 and p_good > 0.8
+    assert m.prior == pytest.approx(9 / 18)
+    assert p_far == pytest.approx(m.prior, abs=0.1)
+    assert 0.0 <= m.probability(rng.random((200, 2))).min() <= m.probability(rng.random((200, 2))).max() <= 1.0
+
+
+def test_combinations_follow_their_definitions():
+    alpha = np.array([0.0, 0.5, 1.0])
+    p = np.array([0.2, 0.9, 1.0])
+    assert combine(alpha, p, "fwa", 1.0, 0.5) == pytest.approx([-0.2, -0.45, 0.0])
+    w = 0.5 ** 2.0
+    assert combine(alpha, p, "fia", 2.0, 0.5) == pytest.approx(w * (1 - p) + (1 - w) * np.array([0, 0.5, 1]))
+    assert combine(alpha, p, "fca", 0.5, 0.5).tolist() == [np.inf, 0.5, 1.0]
+    # nothing passes 0.99: the threshold is relaxed until at least 10 % of candidates pass
+    relaxed = combine(alpha, p * 0.5, "fca", 0.99, 0.5)
+    assert np.isfinite(relaxed).sum() >= 1
+
+
+def test_with_every_experiment_failed_the_next_proposals_go_away_from_the_failures():
+    planner = Planner(SQUARE, seed=1)
+    failures = [{"x0": 0.1 + 0.02 * i, "x1": 0.1 + 0.01 * i, "y": None} for i in range(6)]
+    planner.tell(failures)
+    for proposal in planner.ask(2):
+        x = np.array([proposal.params["x0"], proposal.params["x1"]])
+        assert min(np.hypot(*(x - [f["x0"], f["x1"]])) for f in failures) > 0.25
+
+
+@pytest.mark.parametrize("approach", ["fwa", "fia", "fca"])
+def test_every_feasibility_approach_proposes_feasible_points(approach):
+    config = {**SQUARE, "constraints": ["x0 + x1 <= 1.5"], "general": {"feas_approach": approach}}
+    planner = Planner(config, seed=2)
+    rng = np.random.default_rng(2)
+    for _ in range(12):
+        (proposal,) = planner.ask()
+        assert proposal.params["x0"] + proposal.params["x1"] <= 1.5
+        y = None if rng.random() < 0.4 else float(proposal.params["x0"])
+        planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
+
+
+def test_a_region_that_always_fails_is_learned_and_avoided():
+    """x0 > 0.5 and x1 > 0.5 fails (a quarter of the domain); the planner is not told. Over 60 experiments it must
+    propose there far less often than the region's area (uniform sampling: 25 %; measured: about 5 %)."""
+    def run(seed):
+        planner = Planner(SQUARE, seed=seed)
+        inside = 0
+        for _ in range(60):
+            (proposal,) = planner.ask()
+            x0, x1 = proposal.params["x0"], proposal.params["x1"]
+            failed = x0 > 0.5 and x1 > 0.5
+            inside += failed
+            y = None if failed else (x0 - 0.25) ** 2 + (x1 - 0.3) ** 2 + 0.05 * np.sin(20 * x0)
+            planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
+        return inside / 60
+    assert np.mean([run(seed) for seed in (0, 1)]) < 0.125

@@ -1,0 +1,197 @@
+"""The Gaussian-process surrogate (general.surrogate gp/auto): its inputs, its fit, its acquisition under the known
+constraints, batches and pending experiments, failed experiments, the choice of `auto`, and reproducibility."""
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from gryffin_ros.planner import ConfigError, Planner
+from gryffin_ros.planner.space import SearchSpace
+from gryffin_ros.planner.surrogates import gaussian_process as gp_module
+from gryffin_ros.planner.surrogates.gaussian_process import Features, GaussianProcess, fit_size, rank_correlation
+from tests.conftest import branin, branin_feasible
+from tests.planner.strategies.test_properties import exercise, problems
+
+
+def bowl(p):
+    return (p["x0"] - 0.3) ** 2 + (p["x1"] - 0.6) ** 2
+
+
+def run(planner, n, objective):
+    """n ask/tell rounds; the proposals made."""
+    made = []
+    for _ in range(n):
+        for proposal in planner.ask():
+            planner.tell({**proposal.params, "y": objective(proposal.params), "experiment_id": proposal.experiment_id})
+            made.append(proposal)
+    return made
+
+
+def config(surrogate, **general):
+    return {"parameters": [{"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0},
+                           {"name": "x1", "type": "continuous", "low": 0.0, "high": 1.0}],
+            "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": surrogate, **general}}
+
+
+def test_features_map_every_kind_of_parameter_into_the_unit_cube():
+    space = SearchSpace.from_config([
+        {"name": "t", "type": "continuous", "low": 10, "high": 20},
+        {"name": "angle", "type": "continuous", "low": 0, "high": 360, "periodic": True},
+        {"name": "n", "type": "discrete", "options": [1, 2, 4, 8]},
+        {"name": "solvent", "type": "categorical", "options": ["a", "b", "c"],
+         "descriptors": {"a": [1.0, 5.0], "b": [3.0, 5.0], "c": [2.0, 5.0]}},
+        {"name": "base", "type": "categorical", "options": ["x", "y"]}])
+    features = Features(space)
+    # t, angle (sin, cos), n, solvent's first descriptor (the constant second one tells nothing), base as a category
+    assert features.dim == 6 and features.cat_dims == [5]
+    X = space.to_internal([{"t": 15.0, "angle": 90.0, "n": 4, "solvent": "c", "base": "y"}])
+    row = features.of(X).numpy()[0]
+    np.testing.assert_allclose(row, [0.5, 1.0, 0.5, 3 / 7, 0.5, 1.0], atol=1e-12)
+    # the angle's features agree at both ends of its period
+    ends = space.to_internal([{"t": 10.0, "angle": a, "n": 1, "solvent": "a", "base": "x"} for a in (0.0, 360.0)])
+    np.testing.assert_allclose(*features.of(ends).numpy(), atol=1e-12)
+
+
+def test_rank_correlation():
+    a = np.array([1.0, 2.0, 3.0, 4.0])
+    assert rank_correlation(a, a ** 3) == pytest.approx(1.0)
+    assert rank_correlation(a, -a) == pytest.approx(-1.0)
+    assert rank_correlation(a, np.ones(4)) == 0.0
+    assert rank_correlation(np.array([1.0, 1.0, 2.0]), np.array([0.0, 0.0, 5.0])) == pytest.approx(1.0)
+
+
+def test_fit_size_refits_early_then_every_tenth():
+    assert [fit_size(n) for n in (1, 19, 20, 21, 22, 55, 100, 109)] == [1, 19, 20, 20, 22, 55, 100, 100]
+    assert all(n - 10 < fit_size(n) <= n for n in range(1, 120))
+
+
+def test_gp_interpolates_and_predicts_left_out_points_in_order():
+    space = SearchSpace.from_config([{"name": "x0", "type": "continuous", "low": 0, "high": 1},
+                                     {"name": "x1", "type": "continuous", "low": 0, "high": 1}])
+    rng = np.random.default_rng(0)
+    X = rng.random((25, 2))
+    y = np.array([bowl({"x0": a, "x1": b}) for a, b in X])
+    gp = GaussianProcess(space, X, y, seed=0)
+    assert rank_correlation(gp.leave_one_out(), y) > 0.95
+    alpha = gp.acquisition().evaluate(np.array([[0.3, 0.6], [0.95, 0.05]]))
+    assert alpha[0] < alpha[1]  # improvement is expected at the bowl's bottom, not in a far corner
+    # the gradient used by Adam agrees with finite differences
+    x = np.array([[0.4, 0.5]])
+    _, grad = gp.acquisition().value_and_grad(x)
+    step = 1e-6
+    numeric = [(gp.acquisition().evaluate(x + step * e) - gp.acquisition().evaluate(x - step * e))[0] / (2 * step)
+               for e in np.eye(2)]
+    np.testing.assert_allclose(grad[0], numeric, rtol=1e-3, atol=1e-6)
+
+
+def test_gp_planner_finds_the_constrained_branin_minimum():
+    planner = Planner(config("gp"), known_constraints=branin_feasible, seed=3)
+    made = run(planner, 40, lambda p: branin(p["x0"], p["x1"]))
+    assert all(branin_feasible(o.params) for o in planner.observations)
+    assert planner.best().objectives["y"] - 0.397887 < 0.01  # the kernel density needs ~100 for 0.4
+    assert made[0].meta == {} and all(p.meta == {"surrogate": "gp"} for p in made[1:])
+
+
+def test_gp_batches_and_pending_experiments_are_spread_out():
+    planner = Planner(config("gp"), seed=1)
+    run(planner, 6, bowl)
+    first = planner.ask(3)
+    second = planner.ask(2)  # the first three are pending: believed, not proposed again
+    points = np.array([[p.params["x0"], p.params["x1"]] for p in first + second])
+    distances = np.sqrt(((points[:, None] - points[None]) ** 2).sum(-1))[np.triu_indices(5, 1)]
+    assert distances.min() > 1e-3
+    assert all(p.strategy is None and p.meta == {"surrogate": "gp"} for p in first + second)
+
+
+def test_gp_on_a_finite_space_never_repeats_and_finds_the_corner():
+    slope = {"parameters": [{"name": "x0", "type": "discrete", "low": 0, "high": 20},
+                            {"name": "x1", "type": "discrete", "low": 0, "high": 20}],
+             "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"},
+             "constraints": ["not (5 < x0**2 + x1**2 < 25)"]}
+    planner = Planner(slope, seed=0)
+    for x0, x1 in [(16, 13), (17, 8), (7, 12), (16, 10), (20, 12)]:
+        planner.tell({"x0": x0, "x1": x1, "y": x0 + x1})
+    found = None
+    for i in range(6):
+        (proposal,) = planner.ask()
+        planner.tell({**proposal.params, "y": proposal.params["x0"] + proposal.params["x1"],
+                      "experiment_id": proposal.experiment_id})
+        if (proposal.params["x0"], proposal.params["x1"]) == (0, 0):
+            found = i + 1
+            break
+    assert found is not None and found <= 3
+    seen = [(o.params["x0"], o.params["x1"]) for o in planner.observations]
+    assert len(set(seen)) == len(seen)
+
+
+def test_gp_with_categories_and_failed_experiments():
+    mixed = {"parameters": [{"name": "x", "type": "continuous", "low": 0, "high": 1},
+                            {"name": "c", "type": "categorical", "options": ["a", "b", "c"]}],
+             "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"},
+             "constraints": ["c != 'c' or x < 0.5"]}
+    planner = Planner(mixed, seed=2)
+    rng = np.random.default_rng(0)
+    for _ in range(12):
+        (proposal,) = planner.ask()
+        p = proposal.params
+        assert p["c"] != "c" or p["x"] < 0.5
+        failed = p["c"] == "b" and rng.random() < 0.8  # option b mostly fails
+        planner.tell({**p, "y": None if failed else (p["x"] - 0.7) ** 2 + (p["c"] == "c"),
+                      "experiment_id": proposal.experiment_id})
+    late = [o.params["c"] for o in planner.observations[6:]]
+    assert late.count("b") <= 2
+
+
+def test_auto_compares_the_models_and_records_its_choice():
+    planner = Planner(config("auto"), seed=0)
+    early = run(planner, 4, bowl)[-1].meta
+    assert early["surrogate"] == "kde" and "surrogate_reason" in early
+    meta = run(planner, 12, bowl)[-1].meta
+    scores = meta["loo_rank_correlation"]
+    z_gp, z_kde = np.arctanh(min(scores["gp"], 0.999)), np.arctanh(min(scores["kde"], 0.999))
+    assert meta["surrogate"] == ("gp" if z_gp - z_kde > np.sqrt(1.06 / (16 - 3)) else "kde")  # 16 distinct results
+    assert meta["surrogate"] == "gp"  # on a smooth bowl the GP ranks the left-out points better
+    assert scores["gp"] > 0.9
+
+
+def test_auto_keeps_the_kernel_density_on_plateaus():
+    """A step-shaped objective with 3 levels: ties rank nothing, so the score cannot favour the GP."""
+    planner = Planner(config("auto"), seed=0)
+    made = run(planner, 20, lambda p: float(min(2, int(3 * bowl(p)))))
+    assert {p.meta["surrogate"] for p in made[1:]} == {"kde"}
+    assert all("fewer than 5 distinct" in p.meta["surrogate_reason"] for p in made[1:])
+
+
+def test_gp_proposals_survive_a_restart_exactly():
+    """Hyperparameters are refitted from the same first observations after a restart, so a restored planner proposes
+    what the running one does, also between refits (25 observations: fitted to the first 24)."""
+    running = Planner(config("gp"), seed=5)
+    run(running, 25, bowl)
+    assert fit_size(25) == 24
+    restored = Planner.from_state(running.state())
+    a, b = running.ask()[0].params, restored.ask()[0].params
+    assert a == pytest.approx(b, abs=1e-9)
+
+
+def test_missing_botorch_is_a_config_error(monkeypatch):
+    monkeypatch.setattr(gp_module, "_IMPORT_ERROR", ImportError("No module named 'botorch'"))
+    with pytest.raises(ConfigError, match=r"needs BoTorch \(pip install 'gryffin_ros\[gp\]'\)"):
+        Planner(config("gp"))
+    Planner(config("kde"))  # the kernel density does not need it
+
+
+def test_unknown_surrogate_is_refused():
+    with pytest.raises(ConfigError, match="'general.surrogate' must be one of"):
+        Planner(config("forest"))
+
+
+@settings(max_examples=12, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(problem=problems(), surrogate=st.sampled_from(["gp", "auto"]), optimizer=st.sampled_from(["adam", "genetic"]),
+       seed=st.integers(0, 2**31))
+def test_gp_proposals_are_always_feasible_in_bounds_and_typed(problem, surrogate, optimizer, seed):
+    specs, texts, _, _ = problem
+    planner = Planner({"parameters": specs, "objectives": [{"name": "y", "goal": "min"}], "constraints": texts,
+                       "general": {"surrogate": surrogate, "acquisition_optimizer": optimizer,
+                                   "num_random_samples": 15}}, seed=seed)
+    exercise(planner, problem, rounds=7, seed=seed)
