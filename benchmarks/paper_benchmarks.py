@@ -1,8 +1,8 @@
-"""The paper's eight constrained benchmarks: our runs (from `gryffin-ros bench`) next to the published ones.
+"""The paper's eight constrained benchmarks: our runs (from `python benchmarks/bench.py`) next to the published ones.
 
-    gryffin-ros bench --surface branin,schwefel,dejong,discreteackley --strategy adam,genetic,random,deap \\
+    python benchmarks/bench.py --surface branin,schwefel,dejong,discreteackley --strategy adam,genetic,random,deap \\
         --seeds 100 --out bench-results
-    gryffin-ros bench --surface slope,sphere,michalewicz,camel --strategy adam,genetic,random,deap \\
+    python benchmarks/bench.py --surface slope,sphere,michalewicz,camel --strategy adam,genetic,random,deap \\
         --seeds 100 --out bench-results
     python benchmarks/paper_benchmarks.py [--runs bench-results] [--data ../shared/data] [--out benchmarks/results]
 
@@ -24,9 +24,8 @@ from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
-
-from gryffin_ros.benchmarks.runner import STRATEGIES, best_so_far, load_records, summarize
-from gryffin_ros.benchmarks.surfaces import CONTINUOUS_SURFACES, DISCRETE_SURFACES
+from runner import STRATEGIES, best_so_far, load_records, summarize
+from surfaces import CONTINUOUS_SURFACES, DISCRETE_SURFACES
 
 CONTINUOUS = ("branin", "schwefel", "dejong", "discreteackley")
 DISCRETE = ("slope", "sphere", "michalewicz", "camel")

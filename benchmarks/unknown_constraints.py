@@ -17,7 +17,7 @@ import statistics
 from multiprocessing import Pool
 from pathlib import Path
 
-from gryffin_ros.benchmarks.surfaces import DISCRETE_SURFACES, OPTIONS
+from surfaces import DISCRETE_SURFACES, OPTIONS
 
 # Atlas (GP with a feasibility classifier), best setting, recomputed from its raw results (issue text).
 ANCHOR = {"slope": 15.2, "sphere": 14.7, "michalewicz": 23.4, "camel": 48.6}

@@ -8,7 +8,7 @@ A Gryffin 1.0 script runs unchanged but for its import line::
     samples = gryffin.recommend(observations, sampling_strategies=[-1])
 
 Everything is computed by the Planner (its config format is Gryffin's, so Gryffin configs load unchanged); this
-module only translates the calls. What differs from Gryffin 1.0 is listed in the README ("Gryffin 1.0 users").
+module only translates the calls. What differs from Gryffin 1.0 is listed in docs/gryffin1.md.
 """
 
 from __future__ import annotations

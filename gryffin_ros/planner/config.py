@@ -23,7 +23,7 @@ from .space import SearchSpace
 
 TOP_LEVEL_KEYS = {"name", "general", "parameters", "objectives", "constraints", "database", "model"}
 # Gryffin 1.0 keys we accept for compatibility; they change nothing here (ours has no such knob): each is logged once
-# per process as having no effect, with the reason below, and documented in the README.
+# per process as having no effect, with the reason below, and documented in docs/gryffin1.md.
 _NO_BNN = "there is no Bayesian neural network here; kernels are placed on the observations directly"
 _NO_DATABASE = ("Gryffin's database is not written here; the observations are what you pass in, and campaigns run "
                 "by the ROS node are kept in the campaign store (gryffin-ros export)")

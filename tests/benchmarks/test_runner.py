@@ -3,11 +3,10 @@
 import json
 
 import pytest
-
-from gryffin_ros.benchmarks import runner
-from gryffin_ros.benchmarks.runner import Job, best_so_far, run_job, run_jobs, summarize
-from gryffin_ros.benchmarks.surfaces import SURFACES
-from gryffin_ros.cli import main
+import runner
+from bench import main
+from runner import Job, best_so_far, run_job, run_jobs, summarize
+from surfaces import SURFACES
 
 
 def test_discrete_run_stops_at_the_optimum_without_violations():
@@ -61,7 +60,7 @@ def test_summary_of_discrete_and_continuous_runs():
 
 def test_bench_command_runs_in_parallel_and_writes_summaries(tmp_path, capsys):
     out, summaries = tmp_path / "runs", tmp_path / "summary.json"
-    code = main(["bench", "--surface", "slope", "--strategy", "adam,random", "--seeds", "2", "--processes", "2",
+    code = main(["--surface", "slope", "--strategy", "adam,random", "--seeds", "2", "--processes", "2",
                  "--out", str(out), "--json", str(summaries)])
     assert code == 0
     data = json.loads(summaries.read_text())
@@ -72,5 +71,5 @@ def test_bench_command_runs_in_parallel_and_writes_summaries(tmp_path, capsys):
 
 
 def test_bench_command_rejects_unknown_names(capsys):
-    assert main(["bench", "--surface", "rosenbrock"]) == 2
+    assert main(["--surface", "rosenbrock"]) == 2
     assert "rosenbrock" in capsys.readouterr().err

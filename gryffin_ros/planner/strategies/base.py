@@ -182,10 +182,8 @@ class BasePlanner:
 
     def best(self) -> Observation | None:
         """The best successful observation so far (None before the first one)."""
-        successful = [o for o in self.observations if not o.failed]
-        if not successful:
-            return None
-        return successful[int(np.argmin(self.merits(successful)))]
+        from ..progress import best_of
+        return best_of(self, self.observations)
 
     # ---- proposals -------------------------------------------------------------------------------------------
     def ask(self, n: int | None = None) -> list[Proposal]:

@@ -1,5 +1,5 @@
-"""The benchmark runner behind `gryffin-ros bench`: the paper's protocol on the paper's surfaces, in parallel over seeds
-and resumable.
+"""The benchmark runner behind `benchmarks/bench.py`: the paper's protocol on the paper's surfaces, in parallel over
+seeds and resumable.
 
 Protocol (paper, SI): one proposal per ask, the planner's two sampling strategies (lambda = -1, +1) alternating;
 continuous surfaces run a fixed budget and report the best-so-far objective; discrete surfaces stop when the
@@ -23,9 +23,10 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-from ..planner import Genetic, GryffinRosError, Planner, Random
-from ..planner.strategies import BasePlanner
-from .surfaces import SURFACES, ContinuousSurface, DiscreteSurface
+from surfaces import SURFACES, ContinuousSurface, DiscreteSurface
+
+from gryffin_ros.planner import Genetic, GryffinRosError, Planner, Random
+from gryffin_ros.planner.strategies import BasePlanner
 
 # adam/genetic: the kernel density under either acquisition optimizer; gp/auto: general.surrogate gp/auto with Adam
 STRATEGIES = ("adam", "genetic", "gp", "auto", "random", "deap")

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..planner import vectorized
+from gryffin_ros.planner import vectorized
 
 OPTIONS = 21
 NAMES = ("x0", "x1")

@@ -1,1 +1,0 @@
-"""The paper's constrained benchmark surfaces and a runner for campaigns on them."""
