@@ -147,13 +147,20 @@ class Planner(BasePlanner):
         score = -feasibility.probability(candidates) if len(candidates) else np.empty(0)
         points = []
         for _ in range(n):
-            index = (select(self.space, candidates, score, observed, chosen, dist_param=self.config.general.dist_param)
-                     if len(candidates) else None)
-            x = candidates[index] if index is not None else self.random_points(
-                1, rng, np.concatenate([observed, chosen]))[0]
+            x = self._pick(candidates, score, observed, chosen, rng)
             chosen = np.concatenate([chosen, x[None]])
             points.append(x)
         return np.array(points)
+
+    def _pick(self, candidates: np.ndarray, score: np.ndarray, observed: np.ndarray, chosen: np.ndarray,
+              rng: np.random.Generator, diverse: bool = True) -> np.ndarray:
+        """The selected candidate (lowest score, no duplicate, spread out unless `diverse` is off), or a random
+        feasible point when no candidate is left."""
+        index = (select(self.space, candidates, score, observed, chosen, diverse=diverse,
+                        dist_param=self.config.general.dist_param) if len(candidates) else None)
+        if index is None:
+            return self.random_points(1, rng, np.concatenate([observed, chosen]))[0]
+        return candidates[index]
 
     def _surrogates(self, generator: torch.Generator) -> Surrogates:
         """The failure model, then (with a successful experiment) the kernel density of the merits, in that order of
@@ -203,10 +210,7 @@ class Planner(BasePlanner):
                 refined[s] = self._candidates(Acquisition(density, s), start, exhaustive, optimizer, rng,
                                               feasibility)
             candidates, alpha = refined[s]
-            index = (select(self.space, candidates, alpha, observed, chosen, dist_param=self.config.general.dist_param)
-                     if len(candidates) else None)
-            x = candidates[index] if index is not None else self.random_points(
-                1, rng, np.concatenate([observed, chosen]))[0]
+            x = self._pick(candidates, alpha, observed, chosen, rng)
             chosen = np.concatenate([chosen, x[None]])
             points.append(x)
             strategies.append(s)
@@ -238,9 +242,7 @@ class Planner(BasePlanner):
         points = []
         for i in range(n):
             candidates, alpha = self._candidates(gp.acquisition(), start, exhaustive, optimizer, rng, feasibility)
-            index = select(self.space, candidates, alpha, observed, chosen, diverse=False) if len(candidates) else None
-            x = candidates[index] if index is not None else self.random_points(
-                1, rng, np.concatenate([observed, chosen]))[0]
+            x = self._pick(candidates, alpha, observed, chosen, rng, diverse=False)
             chosen = np.concatenate([chosen, x[None]])
             points.append(x)
             if i + 1 < n:

@@ -20,9 +20,13 @@ from gryffin_ros.planner import (
 from tests.conftest import branin, branin_feasible
 
 
-def run(planner, n, objective=lambda p: p["x0"] + p["x1"], name="y"):
+def run(planner, n, objective=lambda p: p["x0"] + p["x1"], name="y", made=None):
+    """n ask/tell rounds; the proposals are appended to `made` when given (tell refuses infeasible observations, so
+    what the planner proposed is what a feasibility check must look at)."""
     for _ in range(n):
         for proposal in planner.ask():
+            if made is not None:
+                made.append(proposal)
             planner.tell({**proposal.params, name: objective(proposal.params),
                           "experiment_id": proposal.experiment_id})
     return planner
@@ -204,18 +208,19 @@ def test_maximization_goal_prefers_larger_values(unit_square_config):
 
 @pytest.mark.parametrize("strategy", [Random, Genetic])
 def test_baselines_share_the_interface_and_respect_constraints(strategy, unit_square_config):
-    planner = run(strategy({**unit_square_config, "constraints": ["x0 <= x1"]}, seed=0), 30)
-    assert len(planner.observations) == 30
-    assert all(o.params["x0"] <= o.params["x1"] for o in planner.observations)
+    made = []
+    planner = run(strategy({**unit_square_config, "constraints": ["x0 <= x1"]}, seed=0), 30, made=made)
+    assert len(planner.observations) == 30 and len(made) == 30
+    assert all(p.params["x0"] <= p.params["x1"] for p in made)
     assert type(planner).from_state(planner.state()).state() == planner.state()
 
 
 def test_constrained_branin_beats_random_search(unit_square_config):
     """Paper constraint, 50 evaluations, 4 seeds: the planner's median best beats random search's."""
     def best_after(strategy, seed, budget=50):
-        planner = strategy(unit_square_config, known_constraints=branin_feasible, seed=seed)
-        run(planner, budget, objective=lambda p: branin(p["x0"], p["x1"]))
-        assert all(branin_feasible(o.params) for o in planner.observations)
+        planner, made = strategy(unit_square_config, known_constraints=branin_feasible, seed=seed), []
+        run(planner, budget, objective=lambda p: branin(p["x0"], p["x1"]), made=made)
+        assert len(made) == budget and all(branin_feasible(p.params) for p in made)
         return planner.best().objectives["y"]
     ours = np.median([best_after(Planner, s) for s in range(4)])
     random = np.median([best_after(Random, s) for s in range(4)])
