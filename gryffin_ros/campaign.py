@@ -204,13 +204,17 @@ class Campaign:
             self._absorb()
 
     # ---- proposals -----------------------------------------------------------------------------------------
-    def propose(self, n: int | None = None, claimed: bool = True) -> list[Proposal]:
+    def propose(self, n: int | None = None, claimed: bool = True,
+                started: Callable[[], None] | None = None) -> list[Proposal]:
         """`n` new proposals (default general.batches), stored before they are returned. `claimed=False` marks
-        them as published without being asked for (auto-propose), so that `claim` hands them out later."""
+        them as published without being asked for (auto-propose), so that `claim` hands them out later.
+        `started` is called once the optimization has begun (status is then "optimizing")."""
         with self._planner_lock:
             with self._state_lock:
                 self._state = "optimizing"
             try:
+                if started is not None:
+                    started()
                 self._absorb()
                 proposals = self.planner.ask(n)
                 self.store.add_proposals(proposals, {"ask_count": str(self.planner.ask_count),
@@ -227,15 +231,20 @@ class Campaign:
             self._absorb()  # what arrived while optimizing
         return proposals
 
-    def claim(self, n: int | None = None) -> list[Proposal]:
+    def claim(self, n: int | None = None, started: Callable[[], None] | None = None) -> list[Proposal]:
         """`n` proposals for someone who asks (the node's recommend): unclaimed pending ones first, each handed out
-        once, then new ones."""
+        once, then new ones (`started` as in `propose`)."""
         n = self.config.general.batches if n is None else n
         with self._state_lock:
             taken, self._unclaimed = self._unclaimed[:n], self._unclaimed[n:]
             handed = [self._pending[i] for i in taken]
         if len(handed) < n:
-            handed += self.propose(n - len(handed))
+            try:
+                handed += self.propose(n - len(handed), started=started)
+            except BaseException:
+                with self._state_lock:  # nothing was handed out: the unclaimed stay unclaimed
+                    self._unclaimed[:0] = [i for i in taken if i in self._pending]
+                raise
         return handed
 
     def owed(self) -> list[Proposal]:

@@ -22,6 +22,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from .planner.config import label, units_of
 from .planner.domain import Observation, Proposal
 from .planner.errors import GryffinRosError
 
@@ -214,20 +215,38 @@ class CampaignStore:
     def count_observations(self) -> int:
         return self._query("SELECT COUNT(*) FROM observations")[0][0]
 
-    # ---- export ----------------------------------------------------------------------------------------------
-    def rows(self) -> list[dict[str, Any]]:
-        """One flat row per observation: seq, experiment_id, parameters, objectives, then meta values."""
+    # ---- export ---------------------------------------------------------------------------------------------
+    def rows(self, digits: int | None = None) -> list[dict[str, Any]]:
+        """One flat row per observation: seq, experiment_id, parameters and objectives (headers with the config's
+        units), failed, the strategy and surrogate of the proposal it reports, then meta values. `digits`: numbers
+        rounded to that many significant digits (None: as stored)."""
+        config = self.config
+        units = units_of(config)
+        names = set(units)  # parameters and objectives: meta values of the same name are not repeated
+        proposals = {p.experiment_id: p for p in self.proposals()}
+
+        def show(value: Any) -> Any:
+            if digits is not None and isinstance(value, float):
+                return float(f"{value:.{digits}g}")
+            return value
+
         out = []
         for seq, observation in enumerate(self.observations(), start=1):
             row: dict[str, Any] = {"seq": seq, "experiment_id": observation.experiment_id}
-            row.update(observation.params)
-            row.update({k: ("" if v is None else v) for k, v in observation.objectives.items()})
-            row.update({k: v for k, v in observation.meta.items() if k not in row and not isinstance(v, (dict, list))})
+            row.update({label(k, units): show(v) for k, v in observation.params.items()})
+            row.update({label(k, units): ("" if v is None else show(v)) for k, v in observation.objectives.items()})
+            proposal = proposals.get(observation.experiment_id)
+            row["failed"] = observation.failed
+            row["strategy"] = "" if proposal is None or proposal.strategy is None else proposal.strategy
+            row["surrogate"] = "" if proposal is None else proposal.meta.get("surrogate", "")
+            row.update({k: show(v) for k, v in observation.meta.items()
+                        if k not in row and k not in names and not isinstance(v, (dict, list))})
             out.append(row)
         return out
 
-    def export_csv(self, path: str | Path) -> int:
-        rows = self.rows()
+    def export_csv(self, path: str | Path, digits: int = 6) -> int:
+        """The experiments as CSV (numbers to `digits` significant digits; the JSON export keeps every digit)."""
+        rows = self.rows(digits)
         columns: list[str] = []
         for row in rows:
             columns.extend(k for k in row if k not in columns)

@@ -64,7 +64,7 @@ def test_redox_campaign_over_ros(tmp_path):
     assert len(rows) >= 6
     allowed = synthesizable()
     assert all((r["r1_label"], r["r3_label"], r["r4_label"], r["r5_label"]) in allowed for r in rows)
-    assert {"abs_lam_diff", "ered", "gsol"} <= set(rows[0])
+    assert {"abs_lam_diff (nm)", "ered (V)", "gsol (eV)", "failed", "strategy", "surrogate"} <= set(rows[0])
 
 
 def test_several_seeds_write_a_summary(tmp_path):

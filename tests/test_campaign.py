@@ -183,3 +183,20 @@ def test_a_closed_campaign_stores_nothing_more(tmp_path):
     with pytest.raises(CampaignClosed):
         campaign.observe(report(proposal))
     assert stored_ids(path) == []
+
+
+def test_status_says_optimizing_while_proposing_and_a_failed_claim_keeps_the_unclaimed(tmp_path, monkeypatch):
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    seen = []
+    published = campaign.propose(1, claimed=False, started=lambda: seen.append(campaign.status()["state"]))
+    assert seen == ["optimizing"] and campaign.status()["state"] == "idle"
+
+    def broken(n=None):
+        raise RuntimeError("optimizer crashed")
+    monkeypatch.setattr(campaign.planner, "ask", broken)
+    with pytest.raises(RuntimeError):
+        campaign.claim(2)  # one unclaimed, one to make: the making fails
+    assert campaign.status()["state"] == "error"
+    monkeypatch.undo()
+    assert campaign.claim(1) == published  # still handed out first
+

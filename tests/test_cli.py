@@ -10,6 +10,7 @@ import sys
 import time
 
 from gryffin_ros.rosenv import ros_environment
+from gryffin_ros.storage import CampaignStore
 from tests import fastdds_shm
 
 # Deadlines only catch hangs: many times what a step takes on a busy 2-core machine (the 12-experiment campaign over
@@ -17,9 +18,18 @@ from tests import fastdds_shm
 HANG_S = 600
 
 
-def flow_feasible(row):
-    fc, fs = float(row["F_C"]), float(row["F_S"])
+def flow_feasible(params):
+    fc, fs = params["F_C"], params["F_S"]
     return 30 < fc + fs < 310 and fc < 2 * fs and fs < 2 * fc
+
+
+def stored(path):
+    """Every observation of a store at full precision (the CSV rounds to 6 significant digits)."""
+    store = CampaignStore.open_existing(path)
+    try:
+        return store.observations()
+    finally:
+        store.close()
 
 
 def gryffin_ros(*args, timeout=HANG_S):
@@ -34,9 +44,11 @@ def test_closed_loop_campaign_over_ros(tmp_path):
     done = [int(n) for n in re.findall(r"(\d+)/12 experiments", result.stdout)]
     assert done and done[-1] >= 12
     rows = list(csv.DictReader(open(out / "experiments.csv")))
-    assert len(rows) >= 12
-    assert all(flow_feasible(row) for row in rows)
-    assert {"F_C", "F_S", "T", "X1_X2", "X0", "X1", "X2", "X3", "cost"} <= set(rows[0])
+    observations = stored(out / "campaign.sqlite")
+    assert len(rows) == len(observations) >= 12
+    assert all(flow_feasible(o.params) for o in observations)
+    assert {"F_C (uL/min)", "F_S (uL/min)", "T (degC)", "X1_X2 (mole fraction)", "cost ($/min)", "failed", "strategy",
+            "surrogate", "X0", "X1", "X2", "X3"} <= set(rows[0])
     assert (out / "best_so_far.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     export = gryffin_ros("export", str(out / "campaign.sqlite"), "--json", str(tmp_path / "all.json"))
     assert export.returncode == 0, export.stderr
@@ -46,8 +58,19 @@ def test_closed_loop_campaign_over_ros(tmp_path):
 def test_campaign_without_ros_uses_the_same_store_format(tmp_path):
     result = gryffin_ros("campaign", "--no-ros", "--budget", "8", "--seed", "1", "--out", str(tmp_path))
     assert result.returncode == 0, result.stderr
+    observations = stored(tmp_path / "campaign.sqlite")
+    assert len(observations) == 8 and all(flow_feasible(o.params) for o in observations)
     rows = list(csv.DictReader(open(tmp_path / "experiments.csv")))
-    assert len(rows) == 8 and all(flow_feasible(row) for row in rows)
+    assert [row["experiment_id"] for row in rows] == [o.experiment_id for o in observations]
+
+
+def test_export_without_options_writes_both_files_next_to_the_store(tmp_path):
+    assert gryffin_ros("campaign", "--no-ros", "--budget", "3", "--seed", "1", "--out", str(tmp_path)).returncode == 0
+    export = gryffin_ros("export", str(tmp_path / "campaign.sqlite"))
+    assert export.returncode == 0, export.stderr
+    rows = list(csv.DictReader(open(tmp_path / "campaign.csv")))
+    document = json.loads((tmp_path / "campaign.json").read_text())
+    assert len(rows) == len(document["observations"]) == 3
 
 
 def test_ctrl_c_stops_both_nodes_and_keeps_the_results(tmp_path):

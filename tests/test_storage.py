@@ -55,16 +55,22 @@ def test_another_config_is_refused(tmp_path):
 
 
 def test_export_csv_and_json(tmp_path):
-    store = CampaignStore(tmp_path / "c.sqlite", CONFIG, "h1")
-    store.add_observation(Observation({"x": 0.2}, {"y": 2.0}, "b", {"X0": 0.5}))
+    config = {"name": "c", "parameters": [{"name": "x", "type": "continuous", "low": 0, "high": 1, "units": "mL"}],
+              "objectives": [{"name": "y", "goal": "min", "units": "$/min"}]}
+    store = CampaignStore(tmp_path / "c.sqlite", config, "h1")
+    store.add_proposals([Proposal("b", {"x": 0.2}, -1.0, {"surrogate": "gp"})])
+    store.add_observation(Observation({"x": 0.2}, {"y": 2.0 / 3.0}, "b", {"X0": 0.5, "y": 2.0 / 3.0}))
     store.add_observation(Observation({"x": 0.4}, {"y": None}, "a"))
     assert store.export_csv(tmp_path / "out.csv") == 2
     rows = list(csv.DictReader(open(tmp_path / "out.csv")))
-    assert rows[0] == {"seq": "1", "experiment_id": "b", "x": "0.2", "y": "2.0", "X0": "0.5"}
-    assert rows[1]["y"] == ""
+    # units in the headers, 6 significant digits, what chose the point, failed or not; meta not repeating objectives
+    assert rows[0] == {"seq": "1", "experiment_id": "b", "x (mL)": "0.2", "y ($/min)": "0.666667", "failed": "False",
+                       "strategy": "-1.0", "surrogate": "gp", "X0": "0.5"}
+    assert (rows[1]["y ($/min)"], rows[1]["failed"], rows[1]["strategy"], rows[1]["surrogate"]) == ("", "True", "", "")
     store.export_json(tmp_path / "out.json")
     document = json.loads((tmp_path / "out.json").read_text())
-    assert document["config"] == CONFIG and len(document["observations"]) == 2
+    assert document["config"] == config and len(document["observations"]) == 2
+    assert document["observations"][0]["objectives"]["y"] == 2.0 / 3.0  # JSON keeps every digit
     assert CampaignStore.open_existing(tmp_path / "c.sqlite").count_observations() == 2
 
 

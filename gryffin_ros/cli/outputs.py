@@ -13,22 +13,70 @@ from ..planner.progress import best_so_far
 from ..storage import CampaignStore
 
 
+def hierarchy(config: PlannerConfig) -> str:
+    """Chimera's order in words: "X1_X2 >= 0.9 first, then cost as low as possible"."""
+    parts = []
+    for objective in config.objectives:
+        goal = "as high as possible" if objective.goal == "max" else "as low as possible"
+        if objective.tolerance and objective is not config.objectives[-1]:
+            sign = ">=" if objective.goal == "max" else "<="
+            bound = (f"{objective.tolerance:g}" if objective.absolute
+                     else f"within {objective.tolerance:.0%} of its best")
+            goal = f"{sign} {bound}" if objective.absolute else bound
+        parts.append(f"{objective.name} {goal}")
+    return parts[0] + "".join(f", then {part}" for part in parts[1:])
+
+
+def tolerance_line(objective, values: np.ndarray) -> float | None:
+    """Where an objective's Chimera tolerance lies in its own units: the absolute value, or the relative one over
+    the observed range (which moves as the campaign goes on: the final position is drawn)."""
+    if not objective.tolerance:
+        return None
+    if objective.absolute:
+        return objective.tolerance
+    seen = values[np.isfinite(values)]
+    if not len(seen):
+        return None
+    low, high = seen.min(), seen.max()
+    return high - objective.tolerance * (high - low) if objective.goal == "max" else low + objective.tolerance * (
+        high - low)
+
+
 def plot(store: CampaignStore, config: PlannerConfig, path: Path) -> None:
-    """The objectives of the best experiment so far (by the campaign's merit, Chimera included) per experiment."""
+    """Per objective: every experiment as a point (failed ones marked on the axis), the objective of the best
+    experiment so far (by the campaign's merit, Chimera included) as a line, and the Chimera tolerance; axes with
+    the config's units."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    bests = best_so_far(Planner(config, seed=0), store.observations())
-    values = np.array([[np.nan if best is None else best.objectives[obj.name] for obj in config.objectives]
-                       for best in bests])
-    fig, axes = plt.subplots(1, len(config.objectives), figsize=(5 * len(config.objectives), 3.6), squeeze=False)
-    for k, (ax, objective) in enumerate(zip(axes[0], config.objectives)):
-        ax.plot(range(1, len(values) + 1), values[:, k], drawstyle="steps-post", color="tab:blue")
+    observations = store.observations()
+    bests = best_so_far(Planner(config, seed=0), observations)
+    x = np.arange(1, len(observations) + 1)
+    several = len(config.objectives) > 1
+    fig, axes = plt.subplots(1, len(config.objectives), figsize=(5.2 * len(config.objectives), 4.0), squeeze=False)
+    for ax, objective in zip(axes[0], config.objectives):
+        values = np.array([np.nan if o.objectives[objective.name] is None else o.objectives[objective.name]
+                           for o in observations], dtype=float)
+        best = np.array([np.nan if b is None else b.objectives[objective.name] for b in bests], dtype=float)
+        ax.scatter(x, values, s=14, color="0.55", label="experiment", zorder=2)
+        failed = ~np.isfinite(values)
+        if failed.any():
+            ax.plot(x[failed], np.full(failed.sum(), 0.0), "x", color="tab:red", transform=ax.get_xaxis_transform(),
+                    clip_on=False, label="failed")
+        ax.plot(x, best, drawstyle="steps-post", color="tab:blue", lw=2, label="best so far", zorder=3)
+        line = tolerance_line(objective, values) if several else None
+        if line is not None:
+            ax.axhline(line, color="tab:orange", ls="--", lw=1.2,
+                       label=f"tolerance {'>=' if objective.goal == 'max' else '<='} {line:.4g}")
         ax.set_xlabel("experiment")
-        ax.set_ylabel(f"{objective.name} ({objective.goal})")
+        ax.set_ylabel(f"{config.label(objective.name)}, goal: {objective.goal}")
         ax.grid(alpha=0.3)
-    fig.suptitle(f"campaign '{config.name}': the best experiment so far")
+        ax.legend(fontsize=8, loc="best")
+    title = f"campaign '{config.name}': {len(observations)} experiments"
+    if several:  # why a best value can get worse: the best is the Chimera-best, not the best of each objective
+        title += f"\nbest = {hierarchy(config)}"
+    fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -174,10 +174,10 @@ class PlannerNode(Node):
 
     # ---- optimizer (its own callback group) ------------------------------------------------------------------
     def _run(self, make) -> list[Proposal]:
-        """Run `make` (which proposes), reporting status and errors; a failure is raised as GryffinRosError."""
-        self._publish_status()
+        """Run `make(started)` (which proposes and calls `started` once optimizing), reporting status and errors; a
+        failure is raised as GryffinRosError."""
         try:
-            proposals = make()
+            proposals = make(self._publish_status)
         except Exception as exc:
             with self._flag_lock:
                 self._ask_blocked = True
@@ -198,7 +198,7 @@ class PlannerNode(Node):
         if not due or self.campaign.pending:
             return
         try:
-            proposals = self._run(lambda: self.campaign.propose(self.batch_size, claimed=False))
+            proposals = self._run(lambda started: self.campaign.propose(self.batch_size, False, started))
         except GryffinRosError:
             return
         self._publish(self.proposals_pub, messages.proposals_message(
@@ -206,7 +206,7 @@ class PlannerNode(Node):
 
     def _on_recommend(self, request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
         try:
-            proposals = self._run(lambda: self.campaign.claim(self.batch_size))
+            proposals = self._run(lambda started: self.campaign.claim(self.batch_size, started))
         except GryffinRosError as exc:
             response.success = False
             response.message = messages.dump("error", {"error": type(exc).__name__, "reason": str(exc)})

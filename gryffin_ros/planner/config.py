@@ -100,9 +100,29 @@ class PlannerConfig:
     base_dir: Path | None = None  # relative file names in the config (lookup tables) are taken from here
 
     @property
+    def units(self) -> dict[str, str]:
+        """Units of parameters and objectives, by name, as the config gives them (optional; "" where none)."""
+        return units_of(self.raw)
+
+    def label(self, name: str) -> str:
+        """`name (units)`, or the name alone when it has no units: for axes and column headers."""
+        return label(name, self.units)
+
+    @property
     def hash(self) -> str:
         """Stable digest of the configuration, to tell whether a stored campaign belongs to this config."""
         return hashlib.sha256(json.dumps(self.raw, sort_keys=True).encode()).hexdigest()
+
+
+def units_of(raw: Mapping) -> dict[str, str]:
+    """Units of the parameters and objectives of a config dict, by name ("" where none is given)."""
+    entries = list(raw.get("parameters") or []) + list(raw.get("objectives") or [])
+    return {e["name"]: str(e.get("units") or "") for e in entries if isinstance(e, Mapping) and "name" in e}
+
+
+def label(name: str, units: Mapping[str, str]) -> str:
+    """`name (units)`, or the name alone when it has none: for axes and column headers."""
+    return f"{name} ({units[name]})" if units.get(name) else name
 
 
 def read_config(source: Mapping | str | Path) -> dict:
@@ -192,7 +212,7 @@ def _objectives(spec: Any, parameter_names: tuple[str, ...]) -> list[Objective]:
     for i, item in enumerate(spec):
         if not isinstance(item, Mapping):
             raise ConfigError(f"objectives[{i}] must be a mapping")
-        unknown = set(item) - {"name", "goal", "tolerance", "absolute"}
+        unknown = set(item) - {"name", "goal", "tolerance", "absolute", "units"}
         if unknown:
             raise ConfigError(f"objectives[{i}]: unknown key(s) {sorted(unknown)}")
         name, goal = item.get("name"), item.get("goal", "min")
@@ -202,6 +222,9 @@ def _objectives(spec: Any, parameter_names: tuple[str, ...]) -> list[Objective]:
             raise ConfigError(f"objective '{name}' has the same name as a parameter")
         if goal not in ("min", "max", "minimize", "maximize"):
             raise ConfigError(f"objective '{name}': 'goal' must be 'min' or 'max', got {goal!r}")
+        if not isinstance(item.get("units", ""), str):
+            raise ConfigError(f"objective '{name}': 'units' must be a string such as \"$/min\", got "
+                              f"{item['units']!r}")
         tolerance, absolute = item.get("tolerance", 0.0), item.get("absolute", False)
         if not isinstance(absolute, bool):
             raise ConfigError(f"objective '{name}': 'absolute' must be true or false, got {absolute!r}")

@@ -55,7 +55,7 @@ class CategoricalParameter:
 Parameter = ContinuousParameter | DiscreteParameter | CategoricalParameter
 
 # size and process_constrained: Gryffin 1.0 keys, accepted (see parameter_from_spec)
-_COMMON_KEYS = {"name", "type", "size", "process_constrained"}
+_COMMON_KEYS = {"name", "type", "size", "process_constrained", "units"}
 _ALLOWED_KEYS = {
     "continuous": _COMMON_KEYS | {"low", "high", "periodic", "size"},
     "discrete": _COMMON_KEYS | {"low", "high", "options", "size"},
@@ -110,6 +110,9 @@ def parameter_from_spec(spec: Mapping[str, Any], position: int) -> Parameter:
     unknown = set(spec) - _ALLOWED_KEYS[kind]
     if unknown:
         raise ConfigError(f"{where}: unknown key(s) {sorted(unknown)} for a {kind} parameter")
+    units = spec.get("units", "")
+    if not isinstance(units, str):
+        raise ConfigError(f"{where}: 'units' must be a string such as \"degC\" or \"uL/min\", got {units!r}")
     size = spec.get("size", 1)
     if isinstance(size, bool) or not isinstance(size, int) or size < 1:
         raise ConfigError(f"{where}: 'size' must be a positive integer, got {size!r}")
