@@ -16,7 +16,7 @@ setup(
     python_requires=">=3.10",
     packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
     include_package_data=True,
-    package_data={PACKAGE: ["resources/*.xml", "emulators/data/*"]},
+    package_data={PACKAGE: ["resources/*.xml", "emulators/data/*", "dashboard/static/*"]},
     data_files=[
         (f"share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
@@ -30,9 +30,12 @@ setup(
         "jsonschema>=4.0",
         "PyYAML>=6.0",
         "matplotlib>=3.7",
+        # the dashboard's plots: plotly.js, served from this package's copy (the page works offline)
+        "plotly>=5",
     ],
     extras_require={
-        "test": ["pytest>=8", "hypothesis>=6", "ruff>=0.5"],
+        # selenium drives Debian's chromium (chromium-driver) in the dashboard's browser tests
+        "test": ["pytest>=8", "hypothesis>=6", "ruff>=0.5", "selenium>=4.10"],
         "ros": ["ros-jazzy-rclpy", "ros-jazzy-common-interfaces", "ros-jazzy-rmw-fastrtps-cpp"],
         # general.surrogate gp/auto: BoTorch (GPyTorch, SciPy) on the torch above
         "gp": ["botorch>=0.12"],

@@ -31,7 +31,7 @@ from typing import Any
 
 from .planner import Observation, Planner, Proposal
 from .planner.config import PlannerConfig, load_config, read_config
-from .planner.errors import GryffinRosError
+from .planner.errors import GryffinRosError, ObservationError
 from .storage import CampaignStore
 
 logger = logging.getLogger(__name__)
@@ -144,6 +144,9 @@ class Campaign:
             self._active += 1
         try:
             return self._observe(item, raw)
+        except (ObservationError, Rejected) as exc:
+            self.reject(str(exc), raw, item.get("experiment_id") if isinstance(item, Mapping) else None)
+            raise
         finally:
             with self._state_lock:
                 self._active -= 1
@@ -184,6 +187,12 @@ class Campaign:
             finally:
                 self._planner_lock.release()
         return observation
+
+    def reject(self, reason: str, raw: str | None = None, experiment_id: Any = None) -> None:
+        """Record a refused observation in the store (the node calls this for messages it cannot even parse)."""
+        if self._closed:
+            return
+        self.store.add_rejection(experiment_id if isinstance(experiment_id, str) else None, reason, raw)
 
     def _absorb(self) -> None:
         """Teach the planner what was committed since last time (caller holds the planner lock). If the planner

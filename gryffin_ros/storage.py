@@ -33,7 +33,11 @@ CREATE TABLE IF NOT EXISTS proposals (
 CREATE TABLE IF NOT EXISTS observations (
     seq INTEGER PRIMARY KEY AUTOINCREMENT, experiment_id TEXT NOT NULL UNIQUE, params TEXT NOT NULL,
     objectives TEXT NOT NULL, meta TEXT NOT NULL, raw TEXT, received REAL NOT NULL);
+CREATE TABLE IF NOT EXISTS rejections (
+    seq INTEGER PRIMARY KEY AUTOINCREMENT, experiment_id TEXT, reason TEXT NOT NULL, raw TEXT, received REAL NOT NULL);
 """
+# A refused message is kept up to this many characters (what was wrong is in the reason; the rest is evidence).
+REJECTED_RAW_CHARS = 4096
 
 
 class StoreError(GryffinRosError):
@@ -189,6 +193,20 @@ class CampaignStore:
         except sqlite3.IntegrityError:
             raise StoreError(f"experiment_id '{observation.experiment_id}' was already reported") from None
 
+    def add_rejection(self, experiment_id: str | None, reason: str, raw: str | None = None) -> None:
+        """Record an observation that was refused (nothing of it enters the campaign): for the dashboard and audits."""
+        with self._transaction():
+            self._db.execute("INSERT INTO rejections (experiment_id, reason, raw, received) VALUES (?, ?, ?, ?)",
+                             (experiment_id, reason, None if raw is None else raw[:REJECTED_RAW_CHARS], time.time()))
+
+    def rejections(self) -> list[dict[str, Any]]:
+        """Refused observations, oldest first (none in a store written before they were recorded)."""
+        try:
+            rows = self._query("SELECT experiment_id, reason, received FROM rejections ORDER BY seq")
+        except sqlite3.OperationalError:
+            return []
+        return [{"experiment_id": eid, "reason": reason, "received": received} for eid, reason, received in rows]
+
     def proposals(self) -> list[Proposal]:
         rows = self._query("SELECT experiment_id, params, strategy, meta FROM proposals ORDER BY created, rowid")
         return [Proposal(eid, json.loads(params), strategy, json.loads(meta) if meta else {})
@@ -211,6 +229,11 @@ class CampaignStore:
         """The message an observation arrived in, as it arrived (None when it came through the Python API)."""
         rows = self._query("SELECT raw FROM observations WHERE experiment_id = ?", (experiment_id,))
         return rows[0][0] if rows else None
+
+    def counts(self) -> tuple[int, int, int]:
+        """(observations, proposals, rejections) stored: changes whenever the store does."""
+        rows = self._query("SELECT (SELECT COUNT(*) FROM observations), (SELECT COUNT(*) FROM proposals)")
+        return int(rows[0][0]), int(rows[0][1]), len(self.rejections())
 
     def count_observations(self) -> int:
         return self._query("SELECT COUNT(*) FROM observations")[0][0]

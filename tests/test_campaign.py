@@ -78,6 +78,9 @@ def test_refused_observations_store_nothing(tmp_path):
     with pytest.raises(Rejected, match="needs the experiment_id"):
         campaign.observe({"params": proposal.params, "objectives": {"y": 1.0}})
     assert stored_ids(path) == [] and campaign.pending == [proposal]
+    rejected = campaign.store.rejections()  # kept apart, with their reasons, for the dashboard and audits
+    assert [r["experiment_id"] for r in rejected] == [proposal.experiment_id, "made-up", None]
+    assert "violate the known constraint" in rejected[0]["reason"] and "did not propose" in rejected[1]["reason"]
     prior = Campaign(CONFIG, tmp_path / "prior.sqlite", seed=0, accept_unsolicited=True)
     prior.observe({"params": {"x": 1.0, "solvent": "DMF"}, "objectives": {"y": 0.3}})
     prior.observe({"experiment_id": "lab-7", "params": {"x": 2.0, "solvent": "DMF"}, "objectives": {"y": None}})

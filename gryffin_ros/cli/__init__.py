@@ -8,7 +8,7 @@ import sys
 from collections.abc import Sequence
 
 from ..planner import GryffinRosError
-from .outputs import export
+from .outputs import dashboard, export
 from .run import campaign
 
 
@@ -26,6 +26,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     run.add_argument("--seeds", type=int, default=None,
                      help="run N campaigns (seeds from --seed, default 0) into <out>/seed-<k>/, with a summary")
     run.add_argument("--noise", action="store_true", help="redox emulator: add the published noise to DFT values")
+    run.add_argument("--dashboard", type=int, default=None, metavar="PORT",
+                     help="serve the campaign's live page on this port of 127.0.0.1 while it runs (0: any free port)")
     run.set_defaults(handler=campaign)
     exp = sub.add_parser("export", help="write a campaign store's experiments as CSV and/or JSON (default: both, "
                                         "next to the store)")
@@ -33,6 +35,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     exp.add_argument("--csv", help="CSV file to write")
     exp.add_argument("--json", help="JSON file to write")
     exp.set_defaults(handler=export)
+    board = sub.add_parser("dashboard", help="serve a live, read-only page of a campaign store (local, offline)")
+    board.add_argument("store", help="campaign SQLite file (may belong to a campaign still running)")
+    board.add_argument("--port", type=int, default=8050, help="port (default 8050; 0: any free one)")
+    board.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1: this machine only)")
+    board.add_argument("--config", help="the campaign's config file, when its constraints name files (lookup tables) "
+                                        "relative to it; default: relative to the store")
+    board.set_defaults(handler=dashboard)
     args = parser.parse_args(argv)
     if (getattr(args, "budget", 1) or 1) < 1:
         parser.error("--budget must be at least 1")

@@ -3,43 +3,16 @@
 from __future__ import annotations
 
 import argparse
+import threading
 from pathlib import Path
 
 import numpy as np
 
-from ..planner import Planner
+from ..planner import GryffinRosError, Planner
+from ..planner.chimera import hierarchy, tolerance_line
 from ..planner.config import PlannerConfig
 from ..planner.progress import best_so_far
 from ..storage import CampaignStore
-
-
-def hierarchy(config: PlannerConfig) -> str:
-    """Chimera's order in words: "X1_X2 >= 0.9 first, then cost as low as possible"."""
-    parts = []
-    for objective in config.objectives:
-        goal = "as high as possible" if objective.goal == "max" else "as low as possible"
-        if objective.tolerance and objective is not config.objectives[-1]:
-            sign = ">=" if objective.goal == "max" else "<="
-            bound = (f"{objective.tolerance:g}" if objective.absolute
-                     else f"within {objective.tolerance:.0%} of its best")
-            goal = f"{sign} {bound}" if objective.absolute else bound
-        parts.append(f"{objective.name} {goal}")
-    return parts[0] + "".join(f", then {part}" for part in parts[1:])
-
-
-def tolerance_line(objective, values: np.ndarray) -> float | None:
-    """Where an objective's Chimera tolerance lies in its own units: the absolute value, or the relative one over
-    the observed range (which moves as the campaign goes on: the final position is drawn)."""
-    if not objective.tolerance:
-        return None
-    if objective.absolute:
-        return objective.tolerance
-    seen = values[np.isfinite(values)]
-    if not len(seen):
-        return None
-    low, high = seen.min(), seen.max()
-    return high - objective.tolerance * (high - low) if objective.goal == "max" else low + objective.tolerance * (
-        high - low)
 
 
 def plot(store: CampaignStore, config: PlannerConfig, path: Path) -> None:
@@ -49,6 +22,7 @@ def plot(store: CampaignStore, config: PlannerConfig, path: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     observations = store.observations()
     bests = best_so_far(Planner(config, seed=0), observations)
@@ -70,6 +44,7 @@ def plot(store: CampaignStore, config: PlannerConfig, path: Path) -> None:
             ax.axhline(line, color="tab:orange", ls="--", lw=1.2,
                        label=f"tolerance {'>=' if objective.goal == 'max' else '<='} {line:.4g}")
         ax.set_xlabel("experiment")
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.set_ylabel(f"{config.label(objective.name)}, goal: {objective.goal}")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="best")
@@ -92,4 +67,24 @@ def export(args: argparse.Namespace) -> int:
     if args.json:
         print(f"{store.export_json(args.json)} observation(s) written to {args.json}")
     store.close()
+    return 0
+
+
+def dashboard(args: argparse.Namespace) -> int:
+    """Serve the store's dashboard until Ctrl-C."""
+    from ..dashboard import start
+    if not 0 <= args.port <= 65535:
+        raise GryffinRosError(f"--port must be 0..65535, got {args.port}")
+    config_dir = Path(args.config).resolve().parent if args.config else None
+    try:
+        server = start(args.store, args.host, args.port, config_dir)
+    except OSError as exc:
+        raise GryffinRosError(f"cannot serve on {args.host}:{args.port}: {exc.strerror}") from None
+    print(f"dashboard of {args.store}: {server.url}  (Ctrl-C to stop)", flush=True)
+    try:
+        threading.Event().wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.close()
     return 0

@@ -134,6 +134,14 @@ def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespa
     out.mkdir(parents=True, exist_ok=True)
     store_path = out / "campaign.sqlite"
     CampaignStore(store_path, config.raw, config.hash).close()  # created (or checked) before anything starts
+    board = None
+    if args.dashboard is not None:  # the live page, read from the store (whichever process writes it)
+        from ..dashboard import start
+        try:
+            board = start(store_path, "127.0.0.1", args.dashboard, Path(config_path).parent)
+        except OSError as exc:
+            raise GryffinRosError(f"--dashboard: cannot serve on port {args.dashboard}: {exc.strerror}") from None
+        print(f"dashboard: {board.url}", flush=True)
     progress = Progress(args.budget)
     interrupted = False
     try:
@@ -151,6 +159,8 @@ def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespa
             plot(store, config, out / "best_so_far.png")
         count, best = BestSoFar(config)(store) if rows else (0, None)
         store.close()
+        if board is not None:
+            board.close()
     print(f"{rows} experiment(s): {out / 'experiments.csv'}, {out / 'best_so_far.png'}, {out / 'campaign.sqlite'}")
     return count, best, interrupted
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 import sys
 import threading
 import time
+from pathlib import Path
 
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
@@ -32,6 +33,8 @@ PARAMETERS = {
     "auto_propose": (True, "publish the next proposals as soon as all pending experiments have reported"),
     "accept_unsolicited": (False, "accept observations whose experiment_id this planner never proposed"),
     "max_message_bytes": (messages.MAX_MESSAGE_BYTES, "larger incoming messages are refused unparsed"),
+    "dashboard_port": (-1, "serve the campaign's live web page on this port (0: any free port; -1: none)"),
+    "dashboard_host": ("127.0.0.1", "address the web page binds to (default: this machine only)"),
 }
 
 
@@ -73,6 +76,9 @@ class PlannerNode(Node):
             raise
         for text in self.campaign.warnings:
             self.get_logger().warning(text)
+        self.dashboard = None
+        if p["dashboard_port"] >= 0:
+            self.dashboard = self._start_dashboard(storage, p["dashboard_host"], p["dashboard_port"], p["config"])
         self._closing = False
         self._ask_blocked = False  # an ask failed; wait for new data before auto-proposing again
         self._flag_lock = threading.Lock()
@@ -106,6 +112,25 @@ class PlannerNode(Node):
             f"{len(owed)} pending; feasible fraction {fraction.value:.3g} ({fraction.method}); seed "
             f"{self.campaign.seed}; acquisition optimizer {self.campaign.config.general.acquisition_optimizer}")
 
+    def _start_dashboard(self, storage: str, host: str, port: int, config: str):
+        from ..dashboard import start  # the web server and plotly load only when asked for
+        try:
+            if storage == ":memory:":
+                raise StartupError("parameter 'dashboard_port': the dashboard reads the campaign store; give "
+                                   "'storage' a file")
+            if port > 65535:
+                raise StartupError(f"parameter 'dashboard_port' must be -1..65535, got {port}")
+            try:
+                server = start(storage, host, port, Path(config).resolve().parent)
+            except OSError as exc:
+                raise StartupError(f"parameter 'dashboard_port': cannot serve on {host}:{port}: {exc.strerror}") \
+                    from None
+        except BaseException:
+            self.campaign.close()
+            raise
+        self.get_logger().info(f"dashboard: {server.url}")
+        return server
+
     # ---- outputs ---------------------------------------------------------------------------------------------
     def _publish(self, publisher, text: str) -> None:
         if self._closing:  # nothing is published once shutdown has begun (the context may be gone)
@@ -136,6 +161,7 @@ class PlannerNode(Node):
             items = messages.observation_items(messages.parse("observation", msg.data, self.max_message_bytes))
         except GryffinRosError as exc:
             self._event("observation_rejected", reason=str(exc))
+            self.campaign.reject(str(exc), msg.data)
             return
         except Exception as exc:  # whatever a sender manages to trigger, the node stays up and says so
             self.get_logger().error(f"internal error parsing an observation message: {exc!r}")
@@ -222,6 +248,8 @@ class PlannerNode(Node):
     def close(self) -> None:
         """Release the campaign, after observations being stored and a running optimization are done."""
         self._closing = True
+        if self.dashboard is not None:
+            self.dashboard.close()
         self.campaign.close()
 
 

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .config import Objective
+from .config import Objective, PlannerConfig
 
 HARD_STEP_SOFTNESS = 1e-5
 
@@ -61,3 +61,32 @@ class Chimera:
                 + _step(shifted[i] - thresholds[i], self.softness) * shifted[i]
         low, high = merit.min(), merit.max()
         return (merit - low) / (high - low) if high > low else np.zeros(n)
+
+
+def hierarchy(config: PlannerConfig) -> str:
+    """Chimera's order in words: "X1_X2 >= 0.9 first, then cost as low as possible"."""
+    parts = []
+    for objective in config.objectives:
+        goal = "as high as possible" if objective.goal == "max" else "as low as possible"
+        if objective.tolerance and objective is not config.objectives[-1]:
+            sign = ">=" if objective.goal == "max" else "<="
+            bound = (f"{objective.tolerance:g}" if objective.absolute
+                     else f"within {objective.tolerance:.0%} of its best")
+            goal = f"{sign} {bound}" if objective.absolute else bound
+        parts.append(f"{objective.name} {goal}")
+    return parts[0] + "".join(f", then {part}" for part in parts[1:])
+
+
+def tolerance_line(objective: Objective, values: np.ndarray) -> float | None:
+    """Where an objective's Chimera tolerance lies in its own units: the absolute value, or the relative one over
+    the observed range (which moves as the campaign goes on: the final position is drawn)."""
+    if not objective.tolerance:
+        return None
+    if objective.absolute:
+        return objective.tolerance
+    seen = values[np.isfinite(values)]
+    if not len(seen):
+        return None
+    low, high = seen.min(), seen.max()
+    return high - objective.tolerance * (high - low) if objective.goal == "max" else low + objective.tolerance * (
+        high - low)

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from gryffin_ros.cli.outputs import hierarchy, plot, tolerance_line
+from gryffin_ros.cli.outputs import plot
 from gryffin_ros.planner import ConfigError, Observation, load_config
+from gryffin_ros.planner.chimera import hierarchy, tolerance_line
 from gryffin_ros.storage import CampaignStore
 
 FLOW = {"name": "flow", "parameters": [{"name": "F_C", "type": "continuous", "low": 0, "high": 200, "units": "uL/min"},

@@ -1,10 +1,12 @@
 """The planner node over real DDS: services, observation events, restart on the same store, plugins."""
 
 import json
+import re
 import sqlite3
 import subprocess
 import sys
 import time
+import urllib.request
 
 from gryffin_ros import messages
 
@@ -229,3 +231,19 @@ def test_gp_campaign_over_ros_records_the_surrogate_in_messages_and_store(client
         stored = [json.loads(meta or "{}").get("surrogate") for (meta,) in
                   db.execute("SELECT meta FROM proposals ORDER BY created, rowid")]
     assert stored == [None, "gp", "gp"]
+
+
+def test_the_node_serves_its_campaigns_dashboard_when_asked(client, start_planner, tmp_path):
+    node = start_planner(auto_propose=False, dashboard_port=0)
+    deadline = time.monotonic() + HANG_S
+    while not re.search(r"dashboard: (http://127\.0\.0\.1:\d+/)", node.output()):
+        assert time.monotonic() < deadline and node.process.poll() is None, node.output()
+        time.sleep(0.05)
+    url = re.search(r"dashboard: (http://127\.0\.0\.1:\d+/)", node.output()).group(1)
+    client.recommend()
+    with urllib.request.urlopen(url + "api/campaign", timeout=HANG_S) as response:
+        data = json.loads(response.read())
+    assert data["campaign"] == FLOW_CONFIG["name"] and len(data["pending"]) == 1
+    assert node.stop() == 0
+    refused = start_planner(wait=False, auto_propose=False, dashboard_port=0, storage="\":memory:\"")
+    assert refused.process.wait(timeout=HANG_S) == 2 and "the dashboard reads the campaign store" in refused.output()

@@ -1,0 +1,50 @@
+"""The dashboard's server over real HTTP on loopback: pages, the offline plotting library, read-only."""
+
+import json
+import urllib.error
+import urllib.request
+
+import pytest
+
+from gryffin_ros.dashboard import start
+
+
+def get(url):
+    with urllib.request.urlopen(url, timeout=60) as response:
+        return response.status, response.headers.get("Content-Type"), response.read()
+
+
+@pytest.fixture
+def server(campaign):
+    server = start(campaign.store.path, port=0)
+    yield server
+    server.close()
+
+
+def test_the_page_and_everything_it_loads_come_from_this_server(server):
+    assert server.server_address[0] == "127.0.0.1" and server.url.startswith("http://127.0.0.1:")
+    status, kind, page = get(server.url)
+    assert status == 200 and kind.startswith("text/html")
+    for script in (b'src="plotly.min.js"', b'src="dashboard.js"', b'href="dashboard.css"'):
+        assert script in page
+    assert b"http://" not in page and b"https://" not in page  # no CDN: the page works offline
+    for path in ("plotly.min.js", "dashboard.js", "dashboard.css"):
+        assert get(server.url + path)[0] == 200
+    assert len(get(server.url + "plotly.min.js")[2]) > 1_000_000  # the real library, not a stub
+
+
+def test_the_api_answers_json_and_refuses_what_it_does_not_serve(server):
+    data = json.loads(get(server.url + "api/campaign")[2])
+    assert data["campaign"] == "board_test" and len(data["experiments"]) == 5
+    region = json.loads(get(server.url + "api/feasible?x=x&y=solvent")[2])
+    assert region["y"]["values"] == ["THF", "DMF"]
+    with pytest.raises(urllib.error.HTTPError) as bad:
+        get(server.url + "api/feasible?x=x&y=x")
+    assert bad.value.code == 400 and "two different parameters" in json.loads(bad.value.read())["error"]
+    with pytest.raises(urllib.error.HTTPError) as missing:
+        get(server.url + "nowhere")
+    assert missing.value.code == 404
+    request = urllib.request.Request(server.url + "api/campaign", data=b"{}", method="POST")
+    with pytest.raises(urllib.error.HTTPError) as post:
+        urllib.request.urlopen(request, timeout=60)
+    assert post.value.code == 405  # read-only

@@ -1,0 +1,60 @@
+"""The dashboard's data, from a real store: what the page shows, without a browser."""
+
+import json
+
+import numpy as np
+
+from gryffin_ros.dashboard.view import GRID, CampaignView
+from gryffin_ros.planner import Planner
+from gryffin_ros.planner.progress import best_so_far
+
+from .conftest import CONFIG, add_one
+
+
+def test_the_view_holds_every_experiment_pending_and_rejected_one(campaign):
+    view = CampaignView(campaign.store.path)
+    data = view.campaign()
+    json.dumps(data, allow_nan=False)  # valid JSON: no NaN or infinity anywhere
+    assert [e["seq"] for e in data["experiments"]] == [1, 2, 3, 4, 5]
+    assert [e["failed"] for e in data["experiments"]] == [False, False, True, False, False]
+    assert data["experiments"][2]["objectives"] == {"y": None, "cost": None}
+    assert len(data["pending"]) == 1 and data["pending"][0]["experiment_id"] == campaign.pending[0].experiment_id
+    assert [r["experiment_id"] for r in data["rejected"]] == ["made-up"]
+    assert {p["name"]: p["units"] for p in data["parameters"]} == {"x": "mL", "solvent": ""}
+    assert data["tolerances"] == {"y": 0.5, "cost": None}
+    assert data["hierarchy"] == "y >= 0.5, then cost as low as possible"
+    expected = best_so_far(Planner(CONFIG, seed=0), campaign.store.observations())
+    assert data["best"]["y"] == [None if b is None else b.objectives["y"] for b in expected]
+    view.close()
+
+
+def test_the_view_follows_the_store_and_recomputes_only_when_it_changed(campaign):
+    view = CampaignView(campaign.store.path)
+    first = view.campaign()
+    assert view.campaign() is first  # nothing changed: the same data, not computed again
+    add_one(campaign)
+    second = view.campaign()
+    assert len(second["experiments"]) == 6 and second["version"] != first["version"]
+    view.close()
+
+
+def test_the_feasible_region_comes_from_the_planners_constraints(campaign):
+    view = CampaignView(campaign.store.path)
+    region = view.feasible("x", "solvent")
+    assert region["y"]["values"] == ["THF", "DMF"] and len(region["x"]["values"]) == GRID
+    share = np.array(region["share"])  # rows: solvent; columns: x
+    x = np.array(region["x"]["values"])
+    # the constraint involves only these two parameters: each cell is wholly feasible or not
+    np.testing.assert_array_equal(share[0], (x < 4).astype(float))
+    np.testing.assert_array_equal(share[1], (x < 8).astype(float))
+    view.close()
+
+
+def test_a_config_whose_constraints_cannot_be_loaded_still_shows_the_campaign(tmp_path):
+    from gryffin_ros.storage import CampaignStore
+    raw = {**CONFIG, "constraints": [{"plugin": "lookup", "options": {"file": "feasible.csv"}}]}
+    CampaignStore(tmp_path / "c.sqlite", raw, "h").close()
+    view = CampaignView(tmp_path / "c.sqlite", config_dir=tmp_path / "elsewhere")
+    data = view.campaign()
+    assert data["experiments"] == [] and "feasible.csv" in data["constraint_error"]
+    view.close()
