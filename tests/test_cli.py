@@ -100,3 +100,22 @@ def _observations(path):
             return db.execute("SELECT COUNT(*) FROM observations").fetchone()[0]
     except sqlite3.OperationalError:
         return 0
+
+
+def test_dashboard_command_serves_a_store_until_ctrl_c(tmp_path):
+    import urllib.request
+    assert gryffin_ros("campaign", "--no-ros", "--budget", "3", "--seed", "2", "--out", str(tmp_path)).returncode == 0
+    process = subprocess.Popen([sys.executable, "-m", "gryffin_ros.cli", "dashboard", str(tmp_path / "campaign.sqlite"),
+                                "--port", "0"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        line = process.stdout.readline()  # the URL comes first
+        url = re.search(r"(http://127\.0\.0\.1:\d+/)", line).group(1)
+        with urllib.request.urlopen(url + "api/campaign", timeout=HANG_S) as response:
+            assert len(json.loads(response.read())["experiments"]) == 3
+        process.send_signal(signal.SIGINT)
+        assert process.wait(timeout=HANG_S) == 0
+    finally:
+        process.kill()
+    missing = gryffin_ros("dashboard", str(tmp_path / "nothing.sqlite"))
+    assert missing.returncode == 2 and "no campaign store" in missing.stderr
+
