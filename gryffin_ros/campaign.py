@@ -21,9 +21,7 @@ from __future__ import annotations
 
 import copy
 import logging
-import secrets
 import threading
-import time
 import uuid
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -65,15 +63,15 @@ class Campaign:
         self.store = CampaignStore(storage, checked.raw, checked.hash)
         try:
             stored_seed = self.store.get_meta("seed")
-            if seed is None:  # a campaign keeps its seed; a new one takes the config's, else a random one
-                seed = int(stored_seed) if stored_seed is not None else checked.general.random_seed
-            if seed is None:
-                seed = secrets.randbits(63)
-            self.store.set_meta("seed", str(seed))
+            if seed is None and stored_seed is not None:  # a campaign keeps its seed
+                seed = int(stored_seed)
             tuned = copy.deepcopy(checked.raw)
             if settings:
                 tuned.setdefault("general", {}).update(settings)
-            self.planner = Planner(load_config(tuned, base), known_constraints, seed)
+            config_used = load_config(tuned, base) if settings else checked
+            # a new campaign: the seed given, else the config's, else a random one (the Planner's rule)
+            self.planner = Planner(config_used, known_constraints, seed)
+            self.store.set_meta("seed", str(self.planner.seed))
             observations = self.store.observations()
             self.planner.restore(observations, self.store.pending(), int(self.store.get_meta("ask_count") or 0),
                                  int(self.store.get_meta("proposal_count") or 0))
@@ -124,6 +122,7 @@ class Campaign:
 
     def status(self) -> dict[str, Any]:
         """Where the campaign stands (the node's status message)."""
+        warnings = self.warnings  # the first time this studies the domain: not under the lock observations need
         with self._state_lock:
             best = self._best
             return {
@@ -131,7 +130,7 @@ class Campaign:
                 "n_failed": self._n_failed, "state": self._state,
                 "best": None if best is None else {"experiment_id": best.experiment_id, "params": best.params,
                                                    "objectives": best.objectives},
-                "warnings": self.warnings,
+                "warnings": warnings,
             }
 
     # ---- observations --------------------------------------------------------------------------------------
@@ -165,18 +164,22 @@ class Campaign:
             if experiment_id not in self._pending and not self.accept_unsolicited:
                 raise Rejected(f"unknown experiment_id '{experiment_id}': this planner did not propose it (set "
                                "accept_unsolicited to accept prior data)")
-            self._reported.add(experiment_id)  # claimed under the lock: a concurrent duplicate is refused above
+            # claimed under the lock: a concurrent duplicate is refused above, and nobody is handed it meanwhile
+            self._reported.add(experiment_id)
+            was_unclaimed = experiment_id in self._unclaimed
+            if was_unclaimed:
+                self._unclaimed.remove(experiment_id)
         try:
             self.store.add_observation(observation, raw)
         except BaseException:
             with self._state_lock:
                 self._reported.discard(experiment_id)
+                if was_unclaimed:
+                    self._unclaimed.insert(0, experiment_id)
             raise
         with self._state_lock:
             self._inbox.append(observation)
             self._pending.pop(experiment_id, None)
-            if experiment_id in self._unclaimed:
-                self._unclaimed.remove(experiment_id)
             self._n_failed += observation.failed
         if self._planner_lock.acquire(blocking=False):  # never wait for a running optimization here
             try:
@@ -189,10 +192,20 @@ class Campaign:
         return observation
 
     def reject(self, reason: str, raw: str | None = None, experiment_id: Any = None) -> None:
-        """Record a refused observation in the store (the node calls this for messages it cannot even parse)."""
-        if self._closed:
-            return
-        self.store.add_rejection(experiment_id if isinstance(experiment_id, str) else None, reason, raw)
+        """Record a refused observation in the store (the node calls this for messages it cannot even parse). A
+        record that cannot be written is logged, never raised: the refusal itself has been said already."""
+        with self._state_lock:
+            if self._closed:
+                return
+            self._active += 1
+        try:
+            self.store.add_rejection(experiment_id if isinstance(experiment_id, str) else None, reason, raw)
+        except Exception:  # noqa: BLE001
+            logger.exception("could not record a refused observation in the store")
+        finally:
+            with self._state_lock:
+                self._active -= 1
+                self._state_lock.notify_all()
 
     def _absorb(self) -> None:
         """Teach the planner what was committed since last time (caller holds the planner lock). If the planner
@@ -202,9 +215,10 @@ class Campaign:
         if not inbox:
             return
         self.planner.record(inbox)
+        with self._state_lock:  # learnt: out of the inbox before anything else can fail
+            del self._inbox[:len(inbox)]
         best = self.planner.best()
         with self._state_lock:
-            del self._inbox[:len(inbox)]
             self._best = best
 
     def absorb(self) -> None:
@@ -220,7 +234,11 @@ class Campaign:
         `started` is called once the optimization has begun (status is then "optimizing")."""
         with self._planner_lock:
             with self._state_lock:
+                if self._closed:
+                    raise CampaignClosed(f"campaign '{self.name}' is closed; nothing is proposed")
                 self._state = "optimizing"
+            counters = (self.planner.ask_count, self.planner.proposal_count)
+            proposals: list[Proposal] = []
             try:
                 if started is not None:
                     started()
@@ -229,6 +247,8 @@ class Campaign:
                 self.store.add_proposals(proposals, {"ask_count": str(self.planner.ask_count),
                                                      "proposal_count": str(self.planner.proposal_count)})
             except BaseException:
+                if proposals:  # asked but not stored: the planner forgets them, as if never asked
+                    self.planner.retract(proposals, *counters)
                 with self._state_lock:
                     self._state = "error"
                 raise
@@ -256,10 +276,6 @@ class Campaign:
                 raise
         return handed
 
-    def owed(self) -> list[Proposal]:
-        """Pending proposals to announce again (after a restart, or when the lab has gone quiet)."""
-        return self.pending
-
     def mark_unclaimed(self) -> None:
         """Every pending proposal becomes unclaimed again (after a restart they are announced to everyone)."""
         with self._state_lock:
@@ -282,13 +298,3 @@ class Campaign:
 
     def __exit__(self, *exc_info) -> None:
         self.close()
-
-
-def wait_for(condition: Callable[[], bool], timeout: float, interval: float = 0.05) -> bool:
-    """Poll `condition` until it holds or `timeout` seconds pass; whether it held."""
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(interval)
-    return True

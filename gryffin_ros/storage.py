@@ -77,14 +77,25 @@ class CampaignStore:
         self.readonly = readonly
         self._lock = threading.Lock()
         self._holder = None
-        if readonly:
-            try:
-                self._db = sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, check_same_thread=False,
-                                           isolation_level=None, timeout=30.0)
-                self._db.execute("SELECT COUNT(*) FROM observations")
-            except sqlite3.DatabaseError as exc:
-                raise StoreError(f"'{self.path}' is not a campaign store: {exc}") from None
-            return
+        self._db = None
+        try:
+            if readonly:
+                self._open_reader()
+            else:
+                self._open_writer(config, config_hash)
+        except BaseException:  # nothing stays open or locked behind a refusal
+            self.close()
+            raise
+
+    def _open_reader(self) -> None:
+        try:
+            self._db = sqlite3.connect(f"file:{self.path}?mode=ro", uri=True, check_same_thread=False,
+                                       isolation_level=None, timeout=30.0)
+            self._db.execute("SELECT COUNT(*) FROM observations")
+        except sqlite3.DatabaseError as exc:
+            raise StoreError(f"'{self.path}' is not a campaign store: {exc}") from None
+
+    def _open_writer(self, config: dict, config_hash: str) -> None:
         if self.path != ":memory:":
             self._holder = _hold(self.path)
         try:
@@ -96,17 +107,15 @@ class CampaignStore:
             columns = {row[1] for row in self._db.execute("PRAGMA table_info(proposals)")}
             if "meta" not in columns:  # a store written before proposals recorded how they were chosen
                 self._db.execute("ALTER TABLE proposals ADD COLUMN meta TEXT")
+            stored = self.get_meta("config_hash")
+            if stored is None:
+                with self._transaction():
+                    self._set_meta("config", json.dumps(config, sort_keys=True))
+                    self._set_meta("config_hash", config_hash)
+                    self._set_meta("created", repr(time.time()))
         except sqlite3.DatabaseError as exc:
-            self._release()
             raise StoreError(f"cannot open campaign store '{self.path}': {exc}") from None
-        stored = self.get_meta("config_hash")
-        if stored is None:
-            with self._transaction():
-                self._set_meta("config", json.dumps(config, sort_keys=True))
-                self._set_meta("config_hash", config_hash)
-                self._set_meta("created", repr(time.time()))
-        elif stored != config_hash:
-            self.close()
+        if stored is not None and stored != config_hash:
             raise StoreError(
                 f"campaign store '{self.path}' belongs to a different config (stored hash {stored[:12]}, this config "
                 f"{config_hash[:12]}); use another storage file, or the config it was started with")
@@ -117,8 +126,11 @@ class CampaignStore:
         if not Path(path).is_file():
             raise StoreError(f"no campaign store at '{path}'")
         try:
-            with sqlite3.connect(f"file:{path}?mode=ro", uri=True) as db:
+            db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+            try:
                 rows = dict(db.execute("SELECT key, value FROM meta WHERE key IN ('config', 'config_hash')"))
+            finally:
+                db.close()
         except sqlite3.DatabaseError as exc:
             raise StoreError(f"'{path}' is not a campaign store: {exc}") from None
         if set(rows) != {"config", "config_hash"}:
@@ -161,7 +173,8 @@ class CampaignStore:
 
     def close(self) -> None:
         with self._lock:
-            self._db.close()
+            if self._db is not None:
+                self._db.close()
         self._release()
 
     def _release(self) -> None:
@@ -208,7 +221,11 @@ class CampaignStore:
         return [{"experiment_id": eid, "reason": reason, "received": received} for eid, reason, received in rows]
 
     def proposals(self) -> list[Proposal]:
-        rows = self._query("SELECT experiment_id, params, strategy, meta FROM proposals ORDER BY created, rowid")
+        return self._proposals("")
+
+    def _proposals(self, where: str) -> list[Proposal]:
+        rows = self._query(f"SELECT experiment_id, params, strategy, meta FROM proposals {where} "
+                           "ORDER BY created, rowid")
         return [Proposal(eid, json.loads(params), strategy, json.loads(meta) if meta else {})
                 for eid, params, strategy, meta in rows]
 
@@ -220,10 +237,7 @@ class CampaignStore:
 
     def pending(self) -> list[Proposal]:
         """Proposals without an observation yet, oldest first."""
-        rows = self._query("SELECT experiment_id, params, strategy, meta FROM proposals WHERE experiment_id NOT IN "
-                           "(SELECT experiment_id FROM observations) ORDER BY created, rowid")
-        return [Proposal(eid, json.loads(params), strategy, json.loads(meta) if meta else {})
-                for eid, params, strategy, meta in rows]
+        return self._proposals("WHERE experiment_id NOT IN (SELECT experiment_id FROM observations)")
 
     def raw(self, experiment_id: str) -> str | None:
         """The message an observation arrived in, as it arrived (None when it came through the Python API)."""
@@ -233,7 +247,11 @@ class CampaignStore:
     def counts(self) -> tuple[int, int, int]:
         """(observations, proposals, rejections) stored: changes whenever the store does."""
         rows = self._query("SELECT (SELECT COUNT(*) FROM observations), (SELECT COUNT(*) FROM proposals)")
-        return int(rows[0][0]), int(rows[0][1]), len(self.rejections())
+        try:
+            rejected = self._query("SELECT COUNT(*) FROM rejections")[0][0]
+        except sqlite3.OperationalError:  # a store written before rejections were kept
+            rejected = 0
+        return int(rows[0][0]), int(rows[0][1]), int(rejected)
 
     def count_observations(self) -> int:
         return self._query("SELECT COUNT(*) FROM observations")[0][0]

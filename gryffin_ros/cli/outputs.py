@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import sys
 import threading
 from pathlib import Path
 
 import numpy as np
 
-from ..planner import GryffinRosError, Planner
+from ..planner import Planner
 from ..planner.chimera import hierarchy, tolerance_line
 from ..planner.config import PlannerConfig
 from ..planner.progress import best_so_far
@@ -73,14 +74,11 @@ def export(args: argparse.Namespace) -> int:
 def dashboard(args: argparse.Namespace) -> int:
     """Serve the store's dashboard until Ctrl-C."""
     from ..dashboard import start
-    if not 0 <= args.port <= 65535:
-        raise GryffinRosError(f"--port must be 0..65535, got {args.port}")
-    config_dir = Path(args.config).resolve().parent if args.config else None
-    try:
-        server = start(args.store, args.host, args.port, config_dir)
-    except OSError as exc:
-        raise GryffinRosError(f"cannot serve on {args.host}:{args.port}: {exc.strerror}") from None
+    server = start(args.store, args.host, args.port, Path(args.config).resolve().parent if args.config else None)
     print(f"dashboard of {args.store}: {server.url}  (Ctrl-C to stop)", flush=True)
+    if not server.loopback:
+        print(f"warning: {args.host} makes the page reachable from other machines, without authentication",
+              file=sys.stderr)
     try:
         threading.Event().wait()
     except KeyboardInterrupt:

@@ -137,10 +137,7 @@ def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespa
     board = None
     if args.dashboard is not None:  # the live page, read from the store (whichever process writes it)
         from ..dashboard import start
-        try:
-            board = start(store_path, "127.0.0.1", args.dashboard, Path(config_path).parent)
-        except OSError as exc:
-            raise GryffinRosError(f"--dashboard: cannot serve on port {args.dashboard}: {exc.strerror}") from None
+        board = start(store_path, "127.0.0.1", args.dashboard, Path(config_path).parent)
         print(f"dashboard: {board.url}", flush=True)
     progress = Progress(args.budget)
     interrupted = False
@@ -154,13 +151,15 @@ def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespa
     finally:
         progress.close()
         store = CampaignStore.open_existing(store_path)
-        rows = store.export_csv(out / "experiments.csv")
-        if rows:
-            plot(store, config, out / "best_so_far.png")
-        count, best = BestSoFar(config)(store) if rows else (0, None)
-        store.close()
-        if board is not None:
-            board.close()
+        try:
+            rows = store.export_csv(out / "experiments.csv")
+            if rows:
+                plot(store, config, out / "best_so_far.png")
+            count, best = BestSoFar(config)(store) if rows else (0, None)
+        finally:
+            store.close()
+            if board is not None:
+                board.close()
     print(f"{rows} experiment(s): {out / 'experiments.csv'}, {out / 'best_so_far.png'}, {out / 'campaign.sqlite'}")
     return count, best, interrupted
 

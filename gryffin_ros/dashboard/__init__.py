@@ -17,7 +17,10 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import parse_qs, urlparse
 
+from ..planner.errors import GryffinRosError
 from .view import CampaignView
+
+LOOPBACK = {"127.0.0.1", "localhost", "::1"}
 
 STATIC = {
     "/": ("index.html", "text/html; charset=utf-8"),
@@ -43,10 +46,15 @@ class DashboardServer(ThreadingHTTPServer):
         host, port = self.server_address[:2]
         return f"http://{host}:{port}/"
 
+    @property
+    def loopback(self) -> bool:
+        return self.server_address[0] in LOOPBACK
+
     def close(self) -> None:
         self.shutdown()
         self.server_close()
-        self.view.close()
+        with self.lock:  # a request still being answered finishes first
+            self.view.close()
 
 
 class _Handler(BaseHTTPRequestHandler):
@@ -66,7 +74,17 @@ class _Handler(BaseHTTPRequestHandler):
     def _json(self, document: Any, status: HTTPStatus = HTTPStatus.OK) -> None:
         self._send(status, json.dumps(document, allow_nan=False).encode(), "application/json")
 
+    def _host_allowed(self) -> bool:
+        """On loopback, only requests addressed to loopback (a page elsewhere that rebinds its own name to 127.0.0.1
+        cannot read the campaign)."""
+        if not self.server.loopback:
+            return True
+        host = (self.headers.get("Host") or "").rsplit(":", 1)[0].strip("[]")
+        return host in LOOPBACK
+
     def do_GET(self) -> None:  # noqa: N802 - the standard library's name
+        if not self._host_allowed():
+            return self._json({"error": "this dashboard answers requests to 127.0.0.1 only"}, HTTPStatus.FORBIDDEN)
         url = urlparse(self.path)
         if url.path in STATIC:
             name, content_type = STATIC[url.path]
@@ -83,6 +101,8 @@ class _Handler(BaseHTTPRequestHandler):
                     return self._json(self.server.view.feasible(query.get("x", [""])[0], query.get("y", [""])[0]))
         except ValueError as exc:
             return self._json({"error": str(exc)}, HTTPStatus.BAD_REQUEST)
+        except Exception as exc:  # noqa: BLE001 - the page shows it; the server keeps serving
+            return self._json({"error": f"{type(exc).__name__}: {exc}"}, HTTPStatus.INTERNAL_SERVER_ERROR)
         self._json({"error": f"no such page: {url.path}"}, HTTPStatus.NOT_FOUND)
 
     def do_POST(self) -> None:  # noqa: N802
@@ -91,8 +111,17 @@ class _Handler(BaseHTTPRequestHandler):
 
 def start(store: str | Path, host: str = "127.0.0.1", port: int = 0, config_dir: str | Path | None = None
           ) -> DashboardServer:
-    """Serve the dashboard of `store` in a background thread; `server.url` says where, `server.close()` stops it."""
-    server = DashboardServer(CampaignView(store, config_dir), host, port)
+    """Serve the dashboard of `store` in a background thread; `server.url` says where, `server.close()` stops it.
+    Any other `host` than loopback makes the read-only page reachable from the network, without authentication.
+    Raises GryffinRosError (StoreError) for a store that is not there, or a port that cannot be served."""
+    if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+        raise GryffinRosError(f"dashboard port must be 0..65535 (0: any free port), got {port!r}")
+    view = CampaignView(store, config_dir)
+    try:
+        server = DashboardServer(view, host, port)
+    except OSError as exc:
+        view.close()
+        raise GryffinRosError(f"the dashboard cannot serve on {host}:{port}: {exc.strerror or exc}") from None
     threading.Thread(target=server.serve_forever, name="dashboard", daemon=True).start()
     return server
 

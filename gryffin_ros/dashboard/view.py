@@ -45,6 +45,7 @@ class CampaignView:
         except Exception as exc:  # noqa: BLE001 - shown on the page instead of the feasible region
             self.planner, self.constraint_error = None, f"{type(exc).__name__}: {exc}"
         self._cache: tuple[tuple, dict] | None = None
+        self._regions: dict[tuple[str, str], dict] = {}  # the constraints do not change: each pair computed once
 
     def close(self) -> None:
         self.store.close()
@@ -103,7 +104,12 @@ class CampaignView:
         }
 
     def feasible(self, x: str, y: str) -> dict[str, Any]:
-        """The feasible share of each cell of the (x, y) plane, over the other parameters' domain."""
+        """The feasible share of each cell of the (x, y) plane, over the other parameters' domain (cached)."""
+        if (x, y) not in self._regions:
+            self._regions[(x, y)] = self._feasible(x, y)
+        return self._regions[(x, y)]
+
+    def _feasible(self, x: str, y: str) -> dict[str, Any]:
         if self.planner is None:
             raise ValueError(f"the constraints could not be loaded: {self.constraint_error}")
         space = self.planner.space

@@ -101,6 +101,14 @@ def flow_reactor_constraint(options: Mapping[str, Any], parameters: Mapping[str,
     if unknown:
         raise ConfigError(f"flow_reactor constraint: unknown option(s) {sorted(unknown)}; allowed {sorted(allowed)}")
     fc, fs = options.get("c60_flow", "F_C"), options.get("sultine_flow", "F_S")
+    for key, name in (("c60_flow", fc), ("sultine_flow", fs)):
+        if not isinstance(name, str) or name not in parameters or parameters[name].kind != "continuous":
+            continuous = sorted(n for n, p in parameters.items() if p.kind == "continuous")
+            raise ConfigError(f"flow_reactor constraint: '{key}' must name a continuous parameter (one of "
+                              f"{continuous}), got {name!r}")
+    if fc == fs:
+        raise ConfigError(f"flow_reactor constraint: 'c60_flow' and 'sultine_flow' must be two parameters, both are "
+                          f"{fc!r}")
     low, high, ratio = options.get("min_total", 30.0), options.get("max_total", 310.0), options.get("ratio", 2.0)
     for key, value in (("min_total", low), ("max_total", high), ("ratio", ratio)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):

@@ -5,6 +5,7 @@ and ~/get_status stay responsive while it works.
 
 from __future__ import annotations
 
+import json
 import sys
 import threading
 import time
@@ -100,7 +101,7 @@ class PlannerNode(Node):
         # experiments still owed after a quiet spell are announced again (a report may have been lost in a restart)
         self._last_input = time.monotonic()
         self.create_timer(REMIND_AFTER_S / 2, self._remind, callback_group=status_group)
-        owed = self.campaign.owed()
+        owed = self.campaign.pending
         if owed:  # after a restart, the experiments still owed are announced again, to whoever takes them
             self.campaign.mark_unclaimed()
             self._publish(self.proposals_pub, messages.proposals_message(
@@ -118,17 +119,15 @@ class PlannerNode(Node):
             if storage == ":memory:":
                 raise StartupError("parameter 'dashboard_port': the dashboard reads the campaign store; give "
                                    "'storage' a file")
-            if port > 65535:
-                raise StartupError(f"parameter 'dashboard_port' must be -1..65535, got {port}")
-            try:
-                server = start(storage, host, port, Path(config).resolve().parent)
-            except OSError as exc:
-                raise StartupError(f"parameter 'dashboard_port': cannot serve on {host}:{port}: {exc.strerror}") \
-                    from None
-        except BaseException:
+            server = start(storage, host, port, Path(config).resolve().parent)
+        except BaseException as exc:
             self.campaign.close()
+            if isinstance(exc, GryffinRosError) and not isinstance(exc, StartupError):
+                raise StartupError(f"parameter 'dashboard_port': {exc}") from None
             raise
         self.get_logger().info(f"dashboard: {server.url}")
+        if not server.loopback:
+            self.get_logger().warning(f"dashboard on {host}: reachable from other machines, without authentication")
         return server
 
     # ---- outputs ---------------------------------------------------------------------------------------------
@@ -168,8 +167,10 @@ class PlannerNode(Node):
             self._event("observation_rejected", reason=f"internal error: {exc!r}")
             return
         for item in items:
+            # the store keeps the message as it arrived; of a batch, each observation's own part
+            raw = msg.data if len(items) == 1 else json.dumps(item)
             try:
-                self.campaign.observe(item, raw=msg.data)
+                self.campaign.observe(item, raw=raw)
             except GryffinRosError as exc:
                 self._event("observation_rejected", item.get("experiment_id"), str(exc))
                 continue
@@ -189,7 +190,7 @@ class PlannerNode(Node):
             quiet = time.monotonic() - self._last_input > REMIND_AFTER_S
             if quiet:
                 self._last_input = time.monotonic()
-        owed = self.campaign.owed() if quiet and self.auto_propose else []
+        owed = self.campaign.pending if quiet and self.auto_propose else []
         if owed:
             self._publish(self.proposals_pub, messages.proposals_message(self.campaign.name, owed,
                                                                          self.campaign.n_observations))

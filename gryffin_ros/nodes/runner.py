@@ -3,8 +3,9 @@ cannot start, a clean shutdown on Ctrl-C or SIGTERM.
 
 rclpy's own signal handler would invalidate the context at once, while callbacks may still be running in the
 executor's threads (their publishes then fail: "publisher's context is invalid"). Here a signal only ends the spin
-loop; then the node is told to stop publishing (`begin_shutdown`), `on_exit` releases what it holds (waiting for
-running callbacks where it must), and only then are the node and the context shut down.
+loop; then the node is told to stop publishing (`begin_shutdown`), `on_exit` releases what it holds (the planner
+node's campaign waits for observations being stored and a running optimization: rclpy's `Executor.shutdown` does
+not wait for callbacks), and only then are the node and the context shut down. A second signal stops the waiting.
 """
 
 from __future__ import annotations
@@ -32,13 +33,21 @@ def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None
     apply_to_this_process()
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     stop = threading.Event()
-    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
+
+    def on_signal(*_: object) -> None:
+        if stop.is_set():  # a second signal: stop waiting for what is still running
+            raise KeyboardInterrupt
+        stop.set()
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         try:
             node = make_node()
         except GryffinRosError as exc:
             print(f"{label}: cannot start: {exc}", file=sys.stderr)
             return 2
+        except KeyboardInterrupt:
+            return 130
         spinner = executor()
         spinner.add_node(node)
         try:
@@ -46,13 +55,17 @@ def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None
                 spinner.spin_once(timeout_sec=STOP_POLL_S)
         except (KeyboardInterrupt, ExternalShutdownException):
             pass
-        finally:
+        try:
             if hasattr(node, "begin_shutdown"):
                 node.begin_shutdown()
             spinner.shutdown()
             if on_exit is not None:
-                on_exit(node)
+                on_exit(node)  # may wait for a running optimization to write its results
             node.destroy_node()
+        except KeyboardInterrupt:
+            print(f"{label}: stopped on a second signal, without waiting for running callbacks (what was "
+                  "acknowledged is stored)", file=sys.stderr)
+            return 130
         return 0
     finally:
         rclpy.try_shutdown()

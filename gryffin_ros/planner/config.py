@@ -110,8 +110,12 @@ class PlannerConfig:
 
     @property
     def hash(self) -> str:
-        """Stable digest of the configuration, to tell whether a stored campaign belongs to this config."""
-        return hashlib.sha256(json.dumps(self.raw, sort_keys=True).encode()).hexdigest()
+        """Stable digest of the configuration, to tell whether a stored campaign belongs to this config. Units are
+        labels only: editing them keeps the campaign."""
+        entries = {key: [{k: v for k, v in e.items() if k != "units"} if isinstance(e, Mapping) else e
+                         for e in self.raw.get(key) or []]
+                   for key in ("parameters", "objectives") if isinstance(self.raw.get(key), list)}
+        return hashlib.sha256(json.dumps({**self.raw, **entries}, sort_keys=True).encode()).hexdigest()
 
 
 def units_of(raw: Mapping) -> dict[str, str]:

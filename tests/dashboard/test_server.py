@@ -48,3 +48,21 @@ def test_the_api_answers_json_and_refuses_what_it_does_not_serve(server):
     with pytest.raises(urllib.error.HTTPError) as post:
         urllib.request.urlopen(request, timeout=60)
     assert post.value.code == 405  # read-only
+
+
+def test_requests_addressed_to_another_name_are_refused(server):
+    """A page that rebinds its own host name to 127.0.0.1 cannot read the campaign."""
+    request = urllib.request.Request(server.url + "api/campaign", headers={"Host": "attacker.example:80"})
+    with pytest.raises(urllib.error.HTTPError) as refused:
+        urllib.request.urlopen(request, timeout=60)
+    assert refused.value.code == 403
+    request = urllib.request.Request(server.url + "api/campaign", headers={"Host": f"localhost:{server.server_port}"})
+    assert urllib.request.urlopen(request, timeout=60).status == 200
+
+
+def test_a_port_that_cannot_be_served_is_a_clear_error(campaign, server):
+    from gryffin_ros.planner import GryffinRosError
+    with pytest.raises(GryffinRosError, match="cannot serve on 127.0.0.1"):
+        start(campaign.store.path, port=server.server_port)  # taken
+    with pytest.raises(GryffinRosError, match="port must be 0..65535"):
+        start(campaign.store.path, port=70000)

@@ -65,7 +65,8 @@ def test_flow_reactor_plugin_uses_configurable_bounds():
 @pytest.mark.parametrize("options, message", [
     ({"max_flow": 3}, "unknown option(s) ['max_flow']"),
     ({"min_total": 400}, "must be below max_total"),
-    ({"c60_flow": "F_X"}, "unknown name 'F_X'"),
+    ({"c60_flow": "F_X"}, "'c60_flow' must name a continuous parameter"),
+    ({"c60_flow": "F_S"}, "must be two parameters"),
 ])
 def test_flow_reactor_plugin_options_are_checked_at_load(options, message):
     space = SearchSpace.from_config([{"name": "F_C", "type": "continuous", "low": 0, "high": 200},

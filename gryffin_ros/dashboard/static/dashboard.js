@@ -41,7 +41,7 @@ function render() {
   fillSelect($("yaxis"), d.axes, 1);
   drawBest(d);
   drawParams(d);
-  drawPair(d);
+  drawPair(d).catch(() => { state.pairKey = null; });
   drawTables(d);
 }
 
@@ -120,8 +120,16 @@ async function drawPair(d) {
     state.pairKey = key;
     state.region = null;
     if (!d.constraint_error) {
-      const response = await fetch(`api/feasible?x=${encodeURIComponent(x)}&y=${encodeURIComponent(y)}`);
-      state.region = response.ok ? await response.json() : null;
+      let region = null;
+      try {
+        const response = await fetch(`api/feasible?x=${encodeURIComponent(x)}&y=${encodeURIComponent(y)}`);
+        region = response.ok ? await response.json() : null;
+      } catch (error) {
+        region = null;
+      }
+      if (state.pairKey !== key) return;  // the axes changed meanwhile: that drawing is done by the newer call
+      if (region === null) state.pairKey = null;  // not drawn: asked again on the next refresh
+      state.region = region;
     }
   }
   const px = d.parameters.find((p) => p.name === x), py = d.parameters.find((p) => p.name === y);
@@ -193,6 +201,6 @@ function drawTables(d) {
 }
 
 $("objective").onchange = () => state.data && drawParams(state.data);
-$("xaxis").onchange = $("yaxis").onchange = () => state.data && drawPair(state.data);
+$("xaxis").onchange = $("yaxis").onchange = () => state.data && drawPair(state.data).catch(() => { state.pairKey = null; });
 refresh();
 setInterval(refresh, POLL_MS);

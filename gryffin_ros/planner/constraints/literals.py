@@ -72,6 +72,10 @@ def _parameters_of(node: ast.AST, parameters: Mapping[str, Any]) -> list[Any] | 
 def _check_pair(side: ast.AST, op: ast.cmpop, values: list[Any], parameters: Mapping[str, Any]) -> str | None:
     """What is wrong with comparing `side` (an operand) with the literal `values` by `op`, or None."""
     params = _parameters_of(side, parameters)
+    booleans = [v for v in values if isinstance(v, bool)]
+    if params is not None and booleans:  # True == 1 in Python: `n == True` would silently mean `n == 1`
+        return (f"'{params[0].name}' is compared with {booleans[0]!r}; parameters take numbers or option names, "
+                "not true/false")
     strings = [v for v in values if isinstance(v, str)]
     if params is None:
         if strings:  # `side` is not literal here: arithmetic, a call, a comparison

@@ -31,6 +31,9 @@ Parameters = Mapping[str, Parameter]  # every parameter a constraint may name, b
 
 
 def expression_constraint(options: Mapping[str, Any], parameters: Parameters) -> NamedConstraint:
+    unknown = sorted(set(options) - {"expression", "name"}) if isinstance(options, Mapping) else []
+    if unknown:
+        raise ConfigError(f"expression constraint: unknown option(s) {unknown}; it takes only 'expression'")
     text = options.get("expression") if isinstance(options, Mapping) else None
     expression = Expression(text, parameters, parameters)
     return NamedConstraint(text, expression, expression.evaluate)
@@ -162,6 +165,8 @@ def constraint_from_spec(spec: Any, position: int, parameters: Parameters) -> Na
             raise ConfigError(f"constraints[{position}]: unknown key(s) {sorted(unknown)}")
         if "expression" in spec and "plugin" in spec:
             raise ConfigError(f"constraints[{position}]: give 'expression' or 'plugin', not both")
+        if "expression" in spec and "options" in spec:
+            raise ConfigError(f"constraints[{position}]: 'options' belong to a plugin; an expression takes none")
         if "expression" not in spec and not isinstance(spec.get("plugin"), str):
             raise ConfigError(f"constraints[{position}]: needs an 'expression' string or a 'plugin' name")
         try:

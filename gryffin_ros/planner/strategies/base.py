@@ -147,6 +147,13 @@ class BasePlanner:
             if o.experiment_id is not None:
                 self.pending.pop(o.experiment_id, None)
 
+    def retract(self, proposals: Sequence[Proposal], ask_count: int, proposal_count: int) -> None:
+        """Take back proposals that never left (their campaign could not store them): no longer pending, and the
+        counters as they were before the ask, so the next ask draws what it would have drawn."""
+        for proposal in proposals:
+            self.pending.pop(proposal.experiment_id, None)
+        self._ask_count, self._proposal_count = int(ask_count), int(proposal_count)
+
     def restore(self, observations: Sequence[Observation], pending: Sequence[Proposal], ask_count: int,
                 proposal_count: int) -> None:
         """Put a fresh planner where a campaign left it: its validated observations, the proposals still pending

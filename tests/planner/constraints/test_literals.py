@@ -271,3 +271,12 @@ def test_a_mutated_literal_is_always_refused_and_the_original_always_loads(data)
         Planner({**config, "constraints": [text]}, seed=0)
     message = str(info.value)
     assert repr(typo) in message and f"'{slot.parameter['name']}'" in message
+
+
+@pytest.mark.parametrize("spec, expected", [
+    ("n == True", "is compared with True"),
+    ({"expression": "n < 3", "options": {"strict": True}}, "an expression takes none"),
+    ({"plugin": "expression", "options": {"expression": "n < 3", "strict": True}}, "unknown option(s) ['strict']"),
+])
+def test_nothing_a_constraint_says_is_ignored(spec, expected):
+    assert expected in refusal([spec])
