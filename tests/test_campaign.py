@@ -203,3 +203,21 @@ def test_status_says_optimizing_while_proposing_and_a_failed_claim_keeps_the_unc
     monkeypatch.undo()
     assert campaign.claim(1) == published  # still handed out first
 
+
+
+def test_proposals_the_store_could_not_take_are_forgotten_and_drawn_again(tmp_path, monkeypatch):
+    reference = Campaign(CONFIG, tmp_path / "a.sqlite", seed=5).propose(2)
+    campaign = Campaign(CONFIG, tmp_path / "b.sqlite", seed=5)
+
+    def full_disk(proposals, meta=None):
+        raise OSError("disk full")
+    monkeypatch.setattr(campaign.store, "add_proposals", full_disk)
+    with pytest.raises(OSError):
+        campaign.propose(2)
+    assert campaign.planner.pending == {} and campaign.planner.ask_count == 0 and campaign.pending == []
+    monkeypatch.undo()
+    # same seed, same (restored) counters, same process: the very same computation as the reference's first ask
+    assert [p.params for p in campaign.propose(2)] == [p.params for p in reference]
+    campaign.close()
+    with pytest.raises(CampaignClosed):
+        campaign.propose(1)
