@@ -12,7 +12,6 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
 from std_msgs.msg import String
 
@@ -20,7 +19,7 @@ from .. import messages
 from ..emulators import FlowReactorEmulator, RedoxEmulator
 from ..planner import GryffinRosError
 from .qos import LATCHED_QOS, OBSERVATIONS_QOS
-from .runner import run
+from .runner import declare, run
 
 COMMON = {
     "experiment_time_s": (0.0, "simulated duration of one experiment, in seconds"),
@@ -48,10 +47,7 @@ KINDS: dict[str, dict[str, Any]] = {
 class EmulatorNode(Node):
     def __init__(self, kind: str) -> None:
         super().__init__(kind)
-        declared = {**COMMON, **KINDS[kind]["parameters"]}
-        for name, (default, description) in declared.items():
-            self.declare_parameter(name, default, ParameterDescriptor(description=description))
-        p = {name: self.get_parameter(name).value for name in declared}
+        p = declare(self, {**COMMON, **KINDS[kind]["parameters"]})
         if not 0.0 <= p["failure_rate"] <= 1.0:
             raise GryffinRosError(f"parameter 'failure_rate' must be in [0, 1], got {p['failure_rate']}")
         if p["experiment_time_s"] < 0:

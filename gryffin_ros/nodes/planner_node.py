@@ -11,7 +11,6 @@ import threading
 import time
 from pathlib import Path
 
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
@@ -23,7 +22,7 @@ from ..campaign import Campaign
 from ..planner import GryffinRosError, Proposal
 from ..planner.config import read_config
 from .qos import EVENTS_QOS, LATCHED_QOS, OBSERVATIONS_SUBSCRIPTION_QOS, SERVICES_QOS
-from .runner import run
+from .runner import declare, run
 
 PARAMETERS = {
     "config": ("", "path to the campaign config (YAML or JSON; Gryffin format accepted); required"),
@@ -49,9 +48,7 @@ class StartupError(GryffinRosError):
 class PlannerNode(Node):
     def __init__(self) -> None:
         super().__init__("gryffin_planner")
-        for name, (default, description) in PARAMETERS.items():
-            self.declare_parameter(name, default, ParameterDescriptor(description=description))
-        p = {name: self.get_parameter(name).value for name in PARAMETERS}
+        p = declare(self, PARAMETERS)
         if not p["config"]:
             raise StartupError("parameter 'config' is required (path to a YAML or JSON campaign config)")
         if p["batch_size"] < 1:

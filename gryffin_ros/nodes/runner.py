@@ -10,12 +10,16 @@ not wait for callbacks), and only then are the node and the context shut down. A
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
 from collections.abc import Callable
+from typing import Any
 
 import rclpy
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.exceptions import InvalidParameterTypeException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
@@ -25,6 +29,29 @@ from ..rosenv import apply_to_this_process
 
 # How often the spin loop looks at the stop flag (the longest a signal waits to be noticed).
 STOP_POLL_S = 0.1
+_TYPE_NAMES = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list"}
+
+
+def declare(node: Node, parameters: dict[str, tuple[Any, str]]) -> dict[str, Any]:
+    """Declare the node's parameters (name: (default, description)) and return their values; a value of the wrong
+    type (`-p batch_size:=three`) is a GryffinRosError saying what is expected, not rclpy's traceback."""
+    values = {}
+    for name, (default, description) in parameters.items():
+        try:
+            node.declare_parameter(name, default, ParameterDescriptor(description=description))
+        except InvalidParameterTypeException:
+            expected = _TYPE_NAMES.get(type(default), type(default).__name__)
+            raise GryffinRosError(f"parameter '{name}' must be {expected} ({description}); default "
+                                  f"{default!r}") from None
+        values[name] = node.get_parameter(name).value
+    return values
+
+
+def environment_line() -> str:
+    """What a lab client must match to see this node: domain, RMW, discovery range."""
+    return (f"ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID', '0 (unset)')}, "
+            f"RMW_IMPLEMENTATION={os.environ.get('RMW_IMPLEMENTATION', 'default')}, "
+            f"ROS_AUTOMATIC_DISCOVERY_RANGE={os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE', 'default')}")
 
 
 def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None,
@@ -48,6 +75,7 @@ def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None
             return 2
         except KeyboardInterrupt:
             return 130
+        node.get_logger().info(environment_line())
         spinner = executor()
         spinner.add_node(node)
         try:

@@ -1,6 +1,7 @@
 """The planner node over real DDS: services, observation events, restart on the same store, plugins."""
 
 import json
+import os
 import re
 import sqlite3
 import subprocess
@@ -146,6 +147,9 @@ def test_the_config_chooses_the_optimizer_unless_the_node_parameter_overrides_it
     config = {**FLOW_CONFIG, "general": {"acquisition_optimizer": "genetic"}}
     node = start_planner(config, storage=str(tmp_path / "a.sqlite"))
     assert logged(node, "acquisition optimizer genetic")
+    # what a lab client must match to see the node is logged at start-up
+    assert logged(node, f"ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']}, RMW_IMPLEMENTATION=rmw_fastrtps_cpp, "
+                        "ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST")
     assert node.stop() == 0
     node = start_planner(config, storage=str(tmp_path / "b.sqlite"), acquisition_optimizer="adam")
     assert logged(node, "acquisition optimizer adam")

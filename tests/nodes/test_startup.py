@@ -48,3 +48,9 @@ def test_broken_configs_stop_the_node_with_a_message(tmp_path, config):
 def test_bad_parameters_stop_the_node_with_a_message(tmp_path, parameters):
     result = start(tmp_path, FLOW_CONFIG, parameters)
     assert result.returncode == 2 and "cannot start" in result.stderr, result.stderr
+
+
+def test_a_parameter_of_the_wrong_type_is_named_with_what_it_takes(tmp_path):
+    result = start(tmp_path, FLOW_CONFIG, ["batch_size:=three"])
+    assert result.returncode == 2, result.stderr
+    assert "parameter 'batch_size' must be an integer" in result.stderr and "Traceback" not in result.stderr
