@@ -75,10 +75,13 @@ def lookup_constraint(options: Mapping[str, Any], parameters: Parameters) -> Nam
             missing = set(columns.values()) - set(reader.fieldnames or [])
             if missing:
                 raise ConfigError(f"lookup constraint: '{path}' has no column(s) {sorted(missing)}")
+            # the option keys of each categorical parameter, once per table (not once per cell)
+            option_keys = {n: {_lookup_key(o) for o in parameters[n].options} for n in columns
+                           if parameters[n].kind == "categorical"}
             rows = set()
             for row in reader:
-                rows.add(tuple(_lookup_cell(row, columns[n], parameters[n], path, reader.line_num)
-                               for n in columns))
+                rows.add(tuple(_lookup_cell(row, columns[n], parameters[n], option_keys.get(n), path,
+                                            reader.line_num) for n in columns))
     except OSError as exc:
         raise ConfigError(f"lookup constraint: cannot read '{path}': {exc.strerror}") from None
     if not rows:
@@ -94,16 +97,18 @@ def lookup_constraint(options: Mapping[str, Any], parameters: Parameters) -> Nam
     return NamedConstraint(f"lookup({Path(path).name}: {len(rows)} feasible rows)", member, evaluate)
 
 
-def _lookup_cell(row: Mapping[str, Any], column: str, parameter: Parameter, path: str, line: int) -> Any:
-    """One cell of a lookup table as a membership key; a value the parameter cannot take is a ConfigError naming the
-    line (a row that can never match would silently make its combination infeasible, or hide a typo)."""
+def _lookup_cell(row: Mapping[str, Any], column: str, parameter: Parameter, option_keys: set | None, path: str,
+                 line: int) -> Any:
+    """One cell of a lookup table as a membership key (`option_keys`: those of a categorical parameter's options); a
+    value the parameter cannot take is a ConfigError naming the line (a row that can never match would silently make
+    its combination infeasible, or hide a typo)."""
     cell = row.get(column)
     where = f"lookup constraint: '{Path(path).name}' line {line}, column '{column}'"
     if cell is None or not str(cell).strip():
         raise ConfigError(f"{where} is empty")
     key = _lookup_key(cell)
     if parameter.kind == "categorical":
-        if key not in {_lookup_key(o) for o in parameter.options}:
+        if key not in option_keys:
             raise ConfigError(f"{where}: {unknown_option(str(cell).strip(), parameter)}")
         return key
     if not isinstance(key, float) or not math.isfinite(key):
