@@ -1,8 +1,10 @@
 """The peer harness's adapter (../shared/peers, README "Our planner") around gryffin_ros's Planner, one module per
-surrogate: peer_gryffin_ros_kde, peer_gryffin_ros_gp and peer_gryffin_ros_auto each call `adapter(surrogate)`.
+surrogate: peer_gryffin_ros_default (no `surrogate` key: what a user gets), peer_gryffin_ros_kde, _gp and _auto each
+call `adapter(surrogate)`.
 
-Floats become continuous parameters, ints discrete ones (ordered options low..high); the task's constraint is the
-planner's known constraint. Each proposal is reported back under its experiment_id, so nothing stays pending.
+Floats become continuous parameters, ints discrete ones (ordered options low..high), categorical parameters
+(`problems.CatParam`) categorical ones with their descriptors; the task's constraint is the planner's known
+constraint. Each proposal is reported back under its experiment_id, so nothing stays pending.
 """
 
 from __future__ import annotations
@@ -13,15 +15,30 @@ from gryffin_ros.planner import Planner
 DEFAULT_SEEDS = {"branin": range(10), "slope": range(10), "reactor": range(3)}
 
 
-def config(task, surrogate: str) -> dict:
+def config(task, surrogate: str | None) -> dict:
     parameters = []
     for p in task.params:
-        if p.kind == "int":
+        if getattr(p, "categorical", False):
+            parameter = {"name": p.name, "type": "categorical", "options": list(p.options)}
+            if any(p.descriptors):
+                parameter["descriptors"] = dict(zip(p.options, p.descriptors))
+            parameters.append(parameter)
+        elif p.kind == "int":
             parameters.append({"name": p.name, "type": "discrete", "options": list(range(p.low, p.high + 1))})
         else:
             parameters.append({"name": p.name, "type": "continuous", "low": p.low, "high": p.high})
     return {"name": f"peer_{task.name}", "parameters": parameters, "objectives": [{"name": "y", "goal": "min"}],
-            "general": {"surrogate": surrogate}}
+            "general": {"surrogate": surrogate} if surrogate else {}}
+
+
+def to_planner(task, x: list) -> dict:
+    """A harness point (categorical options as indices) -> the planner's parameters."""
+    return {p.name: (p.options[int(v)] if getattr(p, "categorical", False) else v) for p, v in zip(task.params, x)}
+
+
+def from_planner(task, params: dict) -> list:
+    return [(p.options.index(params[p.name]) if getattr(p, "categorical", False) else params[p.name])
+            for p in task.params]
 
 
 class Adapter:
@@ -31,7 +48,7 @@ class Adapter:
         self.names = [p.name for p in task.params]
         self.task = task
         self.planner = Planner(config(task, self.surrogate),
-                               known_constraints=lambda params: task.feasible([params[n] for n in self.names]),
+                               known_constraints=lambda params: task.feasible(from_planner(task, params)),
                                seed=seed)
         self.asked: str | None = None  # experiment_id of the proposal the harness is evaluating
         self.choices: dict[str, int] = {}
@@ -41,14 +58,14 @@ class Adapter:
         self.asked = proposal.experiment_id
         surrogate = proposal.meta.get("surrogate", "random")
         self.choices[surrogate] = self.choices.get(surrogate, 0) + 1
-        return [proposal.params[n] for n in self.names]
+        return from_planner(self.task, proposal.params)
 
     def tell(self, xs, ys) -> None:
         for x, y in zip(xs, ys):
             if y is None:  # a violation (the harness counts it); not an observation of the objective
                 continue
             experiment_id = self.asked if len(xs) == 1 else None
-            self.planner.tell({"experiment_id": experiment_id, "params": dict(zip(self.names, x)),
+            self.planner.tell({"experiment_id": experiment_id, "params": to_planner(self.task, x),
                                "objectives": {"y": float(y)}})
         self.asked = None
 
@@ -56,7 +73,8 @@ class Adapter:
         return {f"chose_{name}": count for name, count in self.choices.items()}
 
 
-def adapter(surrogate: str) -> tuple[str, str, dict, type]:
-    """(PEER, VERSION, DEFAULT_SEEDS, Optimizer) for the harness."""
-    optimizer = type(f"Optimizer_{surrogate}", (Adapter,), {"surrogate": surrogate})
-    return f"gryffin_ros_{surrogate}", gryffin_ros.__version__, DEFAULT_SEEDS, optimizer
+def adapter(surrogate: str | None) -> tuple[str, str, dict, type]:
+    """(PEER, VERSION, DEFAULT_SEEDS, Optimizer) for the harness; surrogate None: the planner's default."""
+    name = surrogate or "default"
+    optimizer = type(f"Optimizer_{name}", (Adapter,), {"surrogate": surrogate})
+    return f"gryffin_ros_{name}", gryffin_ros.__version__, DEFAULT_SEEDS, optimizer

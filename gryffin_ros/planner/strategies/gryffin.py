@@ -236,12 +236,17 @@ class Planner(BasePlanner):
     def _propose_gp(self, n: int, rng: np.random.Generator, gp: GaussianProcess, start: np.ndarray, exhaustive: bool,
                     feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray) -> np.ndarray:
         """n points by the GP's expected improvement; pending experiments and the batch's earlier proposals enter the
-        GP as believed results (kriging believer), so a batch spreads out without Gryffin's strategies."""
+        GP as believed results (kriging believer), so a batch spreads out without Gryffin's strategies. The
+        acquisition is optimized once per ask; each further point of a batch is the best of those candidates under
+        the updated belief."""
         gp.believe(chosen)
         optimizer = self.optimizer()
+        candidates, alpha = self._candidates(gp.acquisition(), start, exhaustive, optimizer, rng, feasibility)
         points = []
         for i in range(n):
-            candidates, alpha = self._candidates(gp.acquisition(), start, exhaustive, optimizer, rng, feasibility)
+            if i:  # the believed points changed the acquisition: the optimized candidates are scored again (an
+                # optimization per point made a plate of 96 take a minute)
+                candidates, alpha = self._candidates(gp.acquisition(), candidates, True, optimizer, rng, feasibility)
             x = self._pick(candidates, alpha, observed, chosen, rng, diverse=False)
             chosen = np.concatenate([chosen, x[None]])
             points.append(x)

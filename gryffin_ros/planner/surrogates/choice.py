@@ -39,20 +39,22 @@ class SurrogateChoice:
     def gaussian_process(self, X: np.ndarray, successful: Sequence[Observation],
                          descriptors: Mapping[int, np.ndarray]) -> GaussianProcess:
         """The GP of the untransformed merits, conditioned on every successful experiment, with hyperparameters
-        fitted to the first `fit_size(n)` of them (cached; learned descriptors change with every observation, so with
+        fitted to the first `fit_size(n)` of them (at most FIT_MAX of those: `fit_subset`; cached; learned descriptors change with every observation, so with
         them every ask fits). Fits are seeded by the campaign seed and their size alone, so they never change the
         draws of the rest of the ask."""
-        from .gaussian_process import GaussianProcess, fit_size
+        from .gaussian_process import FIT_MAX, GaussianProcess, fit_size, fit_subset
 
         def seed(size: int) -> int:
             return int(np.random.default_rng([self.seed, size, 3]).integers(2**62))
 
         size = len(X) if descriptors else fit_size(len(X))
         hyperparameters = self._gp_fit[1] if self._gp_fit and self._gp_fit[0] == size else None
-        if hyperparameters is None and size < len(X):
-            hyperparameters = GaussianProcess(self.space, X[:size], self.raw_merits(successful[:size]),
-                                              seed(size)).hyperparameters
-        gp = GaussianProcess(self.space, X, self.raw_merits(successful), seed(size), descriptors, hyperparameters)
+        y = self.raw_merits(successful)
+        if hyperparameters is None and (size < len(X) or size > FIT_MAX):
+            subset = fit_subset(y[:size], seed(size))
+            hyperparameters = GaussianProcess(self.space, X[subset], y[subset], seed(size), descriptors
+                                              ).hyperparameters
+        gp = GaussianProcess(self.space, X, y, seed(size), descriptors, hyperparameters)
         if not descriptors:
             self._gp_fit = (size, gp.hyperparameters)
         return gp

@@ -1,0 +1,136 @@
+"""Lab-scale ask times of the default planner (issue #20, item 3), one thread, on a constrained smooth problem:
+
+- a warm ask at n = 1000 observations, d = 10 (and the first ask of a fresh planner on those observations);
+- a batch of 8 at n = 200, d = 6;
+- a batch of 96 (a well plate) at n = 500, d = 6, and how spread out it is: the smallest pairwise distance of its
+  points (unit cube) against that of 96 random feasible points (median over 20 draws).
+
+    .venv/bin/python benchmarks/lab_scale.py [--surrogate NAME] [--repeats 3] [--out benchmarks/results/lab_scale.md]
+
+Observations are random feasible points with their objective values, told in one call; "warm" = the planner has
+answered an ask at n - 1 and is told one more result (what a running campaign does).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from gryffin_ros.planner import Planner
+
+
+def problem(d: int, surrogate: str | None) -> dict:
+    names = [f"x{i}" for i in range(d)]
+    general = {"surrogate": surrogate} if surrogate else {}
+    return {"parameters": [{"name": n, "type": "continuous", "low": 0.0, "high": 1.0} for n in names],
+            "objectives": [{"name": "y", "goal": "min"}], "general": general,
+            "constraints": [" + ".join(names) + f" <= {0.6 * d}",
+                            " + ".join(f"(x{i} - 0.5)**2" for i in range(d)) + " >= 0.04"]}
+
+
+def objective(x: np.ndarray) -> float:
+    return float(np.sum(np.sin(5 * x) + (x - 0.3) ** 2))
+
+
+def feasible_points(m: int, d: int, rng: np.random.Generator) -> np.ndarray:
+    out = []
+    while len(out) < m:
+        x = rng.random((4 * m, d))
+        keep = (x.sum(1) <= 0.6 * d) & (((x - 0.5) ** 2).sum(1) >= 0.04)
+        out.extend(x[keep])
+    return np.array(out[:m])
+
+
+def planner_with(n: int, d: int, surrogate: str | None, seed: int) -> tuple[Planner, np.random.Generator]:
+    rng = np.random.default_rng(seed)
+    planner = Planner(problem(d, surrogate), seed=seed)
+    X = feasible_points(n, d, rng)
+    planner.tell([{"params": {f"x{i}": float(v) for i, v in enumerate(x)}, "objectives": {"y": objective(x)}}
+                  for x in X])
+    return planner, rng
+
+
+def timed_ask(planner: Planner, count: int) -> tuple[float, list]:
+    start = time.process_time()
+    proposals = planner.ask(count)
+    return time.process_time() - start, proposals
+
+
+def tell_result(planner: Planner, proposal) -> None:
+    x = np.array([proposal.params[f"x{i}"] for i in range(len(proposal.params))])
+    planner.tell({"experiment_id": proposal.experiment_id, "params": proposal.params,
+                  "objectives": {"y": objective(x)}})
+
+
+def min_distance(points: np.ndarray) -> float:
+    diff = points[:, None, :] - points[None, :, :]
+    dist = np.sqrt((diff ** 2).sum(-1))
+    return float(dist[np.triu_indices(len(points), 1)].min())
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--surrogate", default=None, help="general.surrogate (default: the planner's default)")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--out", default=None)
+    a = ap.parse_args()
+    torch.set_num_threads(1)
+    label = a.surrogate or "default"
+    rows = []
+
+    first, warm, meta = [], [], []
+    for seed in range(a.repeats):
+        planner, _ = planner_with(999, 10, a.surrogate, seed)
+        t, proposals = timed_ask(planner, 1)
+        first.append(t)
+        tell_result(planner, proposals[0])
+        t, proposals = timed_ask(planner, 1)
+        warm.append(t)
+        meta.append(proposals[0].meta)
+        print(f"n=1000 d=10 seed {seed}: first {first[-1]:.2f} s, warm {warm[-1]:.2f} s, meta {meta[-1]}",
+              flush=True)
+    rows.append(("warm ask, n = 1000, d = 10", "≤ 1 s", statistics.median(warm)))
+    rows.append(("first ask, n = 1000, d = 10", "≤ 5 s", statistics.median(first)))
+
+    batch8 = []
+    for seed in range(a.repeats):
+        planner, _ = planner_with(200, 6, a.surrogate, seed)
+        planner.ask(1)  # warm: the fit of this campaign exists
+        t, _ = timed_ask(planner, 8)
+        batch8.append(t)
+        print(f"batch of 8, n=200 d=6 seed {seed}: {t:.2f} s", flush=True)
+    rows.append(("batch of 8, n = 200, d = 6", "≤ 1.5 s", statistics.median(batch8)))
+
+    batch96, spread = [], []
+    for seed in range(a.repeats):
+        planner, rng = planner_with(500, 6, a.surrogate, seed)
+        planner.ask(1)
+        t, proposals = timed_ask(planner, 96)
+        batch96.append(t)
+        points = np.array([[p.params[f"x{i}"] for i in range(6)] for p in proposals])
+        random_spread = statistics.median(min_distance(feasible_points(96, 6, rng)) for _ in range(20))
+        spread.append((min_distance(points), random_spread))
+        print(f"batch of 96, n=500 d=6 seed {seed}: {t:.2f} s, min distance {spread[-1][0]:.3f} "
+              f"(random feasible {random_spread:.3f})", flush=True)
+    rows.append(("batch of 96, n = 500, d = 6", "≤ 15 s", statistics.median(batch96)))
+
+    lines = [f"Lab-scale ask CPU time, surrogate {label} (median of {a.repeats}; one thread; "
+             f"{os.cpu_count()} cores here)", "", "| case | target | CPU s |", "|---|---|---|"]
+    lines += [f"| {case} | {target} | {value:.2f} |" for case, target, value in rows]
+    lines += ["", "Batch of 96: smallest pairwise distance of the proposals (unit cube) vs 96 random feasible "
+              "points (median of 20 draws): " + "; ".join(f"{ours:.3f} vs {rand:.3f}" for ours, rand in spread),
+              "", "Proposal meta at n = 1000: " + "; ".join(str(m) for m in meta)]
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if a.out:
+        Path(a.out).write_text(text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,356 @@
+"""The problem portfolio (issue #20): lab-shaped problems with known constraints, as tasks of the peer harness
+(`../shared/peers`, `--task-module portfolio_tasks`), so BoTorch, GPyOpt and our planner run them side by side.
+
+Pure Python (math, random): the peers' own virtual environments import this module. Every objective is minimized
+(yields enter negated). Families, several functions each so that nothing is tuned to one surface:
+
+- smooth2 / smooth6 / smooth10: smooth continuous functions in 2, 6 and 10 dimensions under nonlinear known
+  constraints (keep-out balls, curved boundaries, sums);
+- mixed: categorical parameters with and without descriptors, ordered discrete ones and continuous ones, whose
+  constraints depend on the category (a solvent's boiling point, a catalyst's stability, forbidden pairs);
+- kinetics: reaction-kinetics-like flow problems (Arrhenius rates, consecutive and parallel reactions, solvent
+  choice, pump and solubility limits).
+
+`reference()` of a task is its constrained optimum where it is known in closed form, else the best of a dense
+search (stated per task); the portfolio aggregator scores each run by the normalized regret
+(best - reference) / (best of the initial design - reference): 1 = no progress past the common initial points,
+0 = the optimum.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+
+from problems import CatParam, Param, Task
+
+# ----------------------------------------------------------------------------------------------------------------
+# smooth continuous
+
+
+def camel(x0, x1):
+    return (4 - 2.1 * x0 ** 2 + x0 ** 4 / 3) * x0 ** 2 + x0 * x1 + (-4 + 4 * x1 ** 2) * x1 ** 2
+
+
+class Camel2(Task):
+    """Six-hump camel; a keep-out disk removes one of its two global minima, a wavy floor cuts the bottom."""
+    name, family, budget = "s2_camel", "smooth2", 40
+    params = [Param("x0", "float", -2.0, 2.0), Param("x1", "float", -1.0, 1.0)]
+
+    def feasible(self, x):
+        x0, x1 = x
+        return ((x0 - 0.0898) ** 2 + (x1 + 0.7126) ** 2 >= 0.3 ** 2
+                and x1 >= -0.95 + 0.25 * math.sin(3.0 * x0))
+
+    def objective(self, x):
+        return camel(*x)
+
+    def reference(self):
+        return -1.031628453  # the remaining global minimum (-0.0898, 0.7126) is feasible
+
+
+class Rosenbrock2(Task):
+    """Rosenbrock's valley, a keep-out disk beside the optimum and a linear cap."""
+    name, family, budget = "s2_rosenbrock", "smooth2", 40
+    params = [Param("x0", "float", -2.0, 2.0), Param("x1", "float", -1.0, 3.0)]
+
+    def feasible(self, x):
+        x0, x1 = x
+        return (x0 - 0.3) ** 2 + (x1 - 1.8) ** 2 >= 0.6 ** 2 and x0 + x1 <= 3.5
+
+    def objective(self, x):
+        x0, x1 = x
+        return 100.0 * (x1 - x0 ** 2) ** 2 + (1 - x0) ** 2
+
+    def reference(self):
+        return 0.0  # (1, 1) is feasible
+
+
+HARTMANN_A = [[10, 3, 17, 3.5, 1.7, 8], [0.05, 10, 17, 0.1, 8, 14], [3, 3.5, 1.7, 10, 17, 8],
+              [17, 8, 0.05, 10, 0.1, 14]]
+HARTMANN_P = [[0.1312, 0.1696, 0.5569, 0.0124, 0.8283, 0.5886], [0.2329, 0.4135, 0.8307, 0.3736, 0.1004, 0.9991],
+              [0.2348, 0.1451, 0.3522, 0.2883, 0.3047, 0.6650], [0.4047, 0.8828, 0.8732, 0.5743, 0.1091, 0.0381]]
+HARTMANN_ALPHA = [1.0, 1.2, 3.0, 3.2]
+
+
+class Hartmann6(Task):
+    """Hartmann-6 on the unit cube with a keep-out ball at the centre and a cap on the sum."""
+    name, family, budget = "s6_hartmann", "smooth6", 60
+    params = [Param(f"x{i}", "float", 0.0, 1.0) for i in range(6)]
+
+    def feasible(self, x):
+        return sum((v - 0.5) ** 2 for v in x) >= 0.3 ** 2 and sum(x) <= 3.2
+
+    def objective(self, x):
+        return -sum(a * math.exp(-sum(A * (v - P) ** 2 for A, v, P in zip(Ai, x, Pi)))
+                    for a, Ai, Pi in zip(HARTMANN_ALPHA, HARTMANN_A, HARTMANN_P))
+
+    def reference(self):
+        return -3.32236801  # the global minimum (0.20, 0.15, 0.48, 0.28, 0.31, 0.66) is feasible
+
+
+def rotation(d, seed):
+    """A fixed random orthonormal d x d matrix (Gram-Schmidt of a seeded Gaussian matrix)."""
+    rng = random.Random(seed)
+    rows = []
+    while len(rows) < d:
+        v = [rng.gauss(0, 1) for _ in range(d)]
+        for r in rows:
+            dot = sum(a * b for a, b in zip(v, r))
+            v = [a - dot * b for a, b in zip(v, r)]
+        norm = math.sqrt(sum(a * a for a in v))
+        rows.append([a / norm for a in v])
+    return rows
+
+
+class Ellipsoid(Task):
+    """A rotated, ill-conditioned quadratic bowl (condition number 100) centred off the middle, inside a ball and
+    under a curved (product) constraint."""
+    d = 6
+
+    def __init__(self):
+        self.params = [Param(f"x{i}", "float", 0.0, 1.0) for i in range(self.d)]
+        self.R = rotation(self.d, 11 + self.d)
+        self.weights = [10 ** (2 * i / (self.d - 1)) for i in range(self.d)]
+        self.centre = [0.62 if i % 2 == 0 else 0.38 for i in range(self.d)]
+
+    def feasible(self, x):
+        return sum((v - 0.5) ** 2 for v in x) <= 0.16 * self.d and x[0] * x[1] <= 0.3
+
+    def objective(self, x):
+        z = [v - c for v, c in zip(x, self.centre)]
+        return sum(w * sum(r * v for r, v in zip(row, z)) ** 2 for w, row in zip(self.weights, self.R)) / self.d
+
+    def reference(self):
+        return 0.0  # the centre is feasible
+
+
+class Ellipsoid6(Ellipsoid):
+    name, family, budget, d = "s6_ellipsoid", "smooth6", 60, 6
+
+
+class Ellipsoid10(Ellipsoid):
+    name, family, budget, d = "s10_ellipsoid", "smooth10", 80, 10
+
+
+class Styblinski10(Task):
+    """Styblinski-Tang (multimodal but smooth, 2^10 local minima) on [-5, 5]^10, a keep-out ball around the
+    positive corner's basin and a cap on sum(sin x)."""
+    name, family, budget = "s10_styblinski", "smooth10", 80
+    params = [Param(f"x{i}", "float", -5.0, 5.0) for i in range(10)]
+
+    def feasible(self, x):
+        return sum((v - 2.75) ** 2 for v in x) >= 3.0 ** 2 and sum(math.sin(v) for v in x) <= 2.0
+
+    def objective(self, x):
+        return sum(v ** 4 - 16 * v ** 2 + 5 * v for v in x) / 2 / 10
+
+    def reference(self):
+        return -39.16616570377142  # (-2.9035, ...) is feasible; value per dimension
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# mixed spaces: constraints that depend on the category
+
+SOLVENTS = {  # boiling point (deg C), polarity (E_T(30), normalized), viscosity (mPa s)
+    "MeCN": (82.0, 0.46, 0.34), "THF": (66.0, 0.21, 0.46), "toluene": (111.0, 0.10, 0.56),
+    "DMF": (153.0, 0.39, 0.80), "EtOH": (78.0, 0.65, 1.07), "dioxane": (101.0, 0.16, 1.18),
+}
+
+
+class Solvent(Task):
+    """A solvent (categorical, with descriptors) + temperature + time (continuous) + equivalents (discrete):
+    temperature below the solvent's boiling point; the yield peaks at a medium polarity, a medium temperature
+    (a side reaction with the higher activation energy wins when hot) and enough but not too much reagent."""
+    name, family, budget = "m_solvent", "mixed", 40
+
+    def __init__(self):
+        names = list(SOLVENTS)
+        self.params = [CatParam("solvent", names, {n: SOLVENTS[n] for n in names}),
+                       Param("T", "float", 20.0, 150.0), Param("t", "float", 0.25, 8.0),
+                       Param("eq", "int", 2, 8)]  # equivalents in half steps: 1.0 .. 4.0
+        self.names = names
+
+    def feasible(self, x):
+        bp = SOLVENTS[self.names[int(x[0])]][0]
+        return x[1] <= bp - 5.0
+
+    def objective(self, x):
+        bp, polarity, viscosity = SOLVENTS[self.names[int(x[0])]]
+        T, t, eq = x[1] + 273.15, x[2], x[3] / 2
+        k = 0.8 * math.exp(-6500 * (1 / T - 1 / 343.15)) * math.exp(-((polarity - 0.35) / 0.2) ** 2) / viscosity
+        k_side = 0.05 * math.exp(-11000 * (1 / T - 1 / 343.15))
+        conversion = 1 - math.exp(-(k + k_side) * t * min(eq, 2.0))
+        selectivity = k / (k + k_side)
+        waste = 0.04 * (eq - 1.0) + 0.01 * t
+        return -(conversion * selectivity - waste)
+
+    def reference(self):
+        return dense_reference(self, cont_steps=161)
+
+
+CATALYSTS = ["Pd(OAc)2", "Pd2dba3", "NiCl2", "CuI"]
+LIGANDS = {"PPh3": (145.0, 0.6), "XPhos": (256.0, 0.9), "dppf": (170.0, 0.5), "PCy3": (170.0, 1.0),
+           "bipy": (120.0, 0.2)}  # cone angle (deg), donor strength (normalized)
+FORBIDDEN_PAIRS = {(0, 3), (2, 0), (3, 1)}
+
+
+class Catalyst(Task):
+    """A catalyst (categorical, no descriptors) x ligand (categorical, with descriptors) + temperature + loading:
+    some pairs are not allowed, one catalyst decomposes above 90 deg C, and loading x temperature is capped (heat)."""
+    name, family, budget = "m_catalyst", "mixed", 40
+
+    def __init__(self):
+        names = list(LIGANDS)
+        self.params = [CatParam("catalyst", CATALYSTS), CatParam("ligand", names, {n: LIGANDS[n] for n in names}),
+                       Param("T", "float", 40.0, 120.0), Param("loading", "float", 0.5, 5.0)]
+        self.ligands = names
+
+    def feasible(self, x):
+        c, l, T, loading = int(x[0]), int(x[1]), x[2], x[3]
+        return (c, l) not in FORBIDDEN_PAIRS and not (c == 1 and T > 90.0) and loading * T <= 400.0
+
+    def objective(self, x):
+        c, l, T, loading = int(x[0]), int(x[1]), x[2], x[3]
+        cone, donor = LIGANDS[self.ligands[l]]
+        best_cone = (200.0, 150.0, 240.0, 170.0)[c]
+        best_T = (85.0, 70.0, 105.0, 60.0)[c]
+        activity = (1.0, 0.9, 0.8, 0.6)[c] * math.exp(-((cone - best_cone) / 50.0) ** 2) * (0.5 + 0.5 * donor)
+        rate = activity * loading * math.exp(-((T - best_T) / 25.0) ** 2)
+        return -(1 - math.exp(-1.5 * rate) - 0.03 * loading)
+
+    def reference(self):
+        return dense_reference(self, cont_steps=201)
+
+
+BASES = ["K2CO3", "Et3N", "DBU"]
+
+
+class Discrete(Task):
+    """Stirring level and pH (ordered integers), a base (categorical, no descriptors), concentration and
+    temperature (continuous): each base allows its own pH window and concentration."""
+    name, family, budget = "m_discrete", "mixed", 40
+
+    def __init__(self):
+        self.params = [Param("stirring", "int", 0, 4), Param("pH", "int", 3, 12), CatParam("base", BASES),
+                       Param("conc", "float", 0.05, 1.0), Param("T", "float", 20.0, 80.0)]
+
+    def feasible(self, x):
+        stirring, pH, base, conc, T = int(x[0]), int(x[1]), int(x[2]), x[3], x[4]
+        low, high, max_conc = ((7, 12, 0.8), (5, 11, 1.0), (8, 12, 0.5))[base]
+        return low <= pH <= high and conc <= max_conc and conc * (1 + stirring) <= 3.0
+
+    def objective(self, x):
+        stirring, pH, base, conc, T = int(x[0]), int(x[1]), int(x[2]), x[3], x[4]
+        best_pH = (10.0, 8.0, 11.0)[base]
+        strength = (0.8, 0.7, 1.0)[base]
+        mixing = 1 - math.exp(-0.8 * (stirring + 0.5))
+        rate = strength * mixing * conc * math.exp(0.035 * (T - 50.0)) * math.exp(-((pH - best_pH) / 1.8) ** 2)
+        degradation = 0.004 * math.exp(0.06 * (T - 50.0)) * (1 + 0.3 * abs(pH - 7))
+        return -(1 - math.exp(-3.0 * rate) - degradation)
+
+    def reference(self):
+        return dense_reference(self, cont_steps=61)
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# reaction kinetics in a flow reactor
+
+KINETIC_SOLVENTS = {"MeCN": (82.0, 1.0), "toluene": (111.0, 0.55), "DMSO": (189.0, 1.6)}  # bp, rate factor
+REACTOR_VOLUME = 10.0  # mL
+
+
+class Kinetics(Task):
+    """Flow reactor: temperature, residence time, concentration, equivalents (continuous) and a solvent
+    (categorical with descriptors: boiling point, rate factor). Known constraints: temperature 10 deg C below the
+    solvent's boiling point, the pump's flow range (volume / residence time in [0.1, 4] mL/min), a solubility cap on
+    concentration x equivalents. Objective: -(yield of the product B) + a reagent and time cost."""
+    family, budget = "kinetics", 50
+    Ea = (60e3, 85e3)  # J/mol: desired step, unwanted step
+    parallel = False
+
+    def __init__(self):
+        names = list(KINETIC_SOLVENTS)
+        self.params = [Param("T", "float", 30.0, 180.0), Param("tau", "float", 1.0, 60.0),
+                       Param("conc", "float", 0.1, 1.5), Param("eq", "float", 1.0, 3.0),
+                       CatParam("solvent", names, {n: KINETIC_SOLVENTS[n] for n in names})]
+        self.solvents = names
+
+    def feasible(self, x):
+        T, tau, conc, eq, s = x[0], x[1], x[2], x[3], int(x[4])
+        flow = REACTOR_VOLUME / tau
+        return T <= KINETIC_SOLVENTS[self.solvents[s]][0] - 10.0 and 0.1 <= flow <= 4.0 and conc * eq <= 2.0
+
+    def objective(self, x):
+        T, tau, conc, eq, s = x[0] + 273.15, x[1], x[2], x[3], int(x[4])
+        factor = KINETIC_SOLVENTS[self.solvents[s]][1]
+        R = 8.314
+        k1 = factor * 0.15 * math.exp(-self.Ea[0] / R * (1 / T - 1 / 353.15)) * conc * eq ** 0.5
+        k2 = 0.02 * math.exp(-self.Ea[1] / R * (1 / T - 1 / 353.15))
+        if self.parallel:  # A -> B (desired) and A -> D (side), B stable
+            yield_b = k1 / (k1 + k2) * (1 - math.exp(-(k1 + k2) * tau))
+        else:  # consecutive A -> B -> C
+            if abs(k1 - k2) < 1e-9:
+                yield_b = k1 * tau * math.exp(-k1 * tau)
+            else:
+                yield_b = k1 / (k2 - k1) * (math.exp(-k1 * tau) - math.exp(-k2 * tau))
+        cost = 0.05 * (eq - 1.0) + 0.002 * tau + 0.05 * conc
+        return -(yield_b - cost)
+
+    def reference(self):
+        return dense_reference(self, cont_steps=21)
+
+
+class Consecutive(Kinetics):
+    name = "k_consecutive"
+
+
+class Parallel(Kinetics):
+    name, parallel, Ea = "k_parallel", True, (50e3, 90e3)
+
+
+# ----------------------------------------------------------------------------------------------------------------
+
+
+def dense_reference(task, cont_steps: int, polish_from: int = 20) -> float:
+    """The best feasible value of a grid over the task (every option of finite parameters, `cont_steps` levels of
+    each continuous one), refined by a coordinate search from the best `polish_from` grid points: the reference of
+    tasks without a closed-form optimum (an upper bound on the true optimum, tight to the grid's resolution)."""
+    import itertools
+    axes = []
+    for p in task.params:
+        if p.kind == "int":
+            axes.append(list(range(p.low, p.high + 1)))
+        else:
+            axes.append([p.low + (p.high - p.low) * i / (cont_steps - 1) for i in range(cont_steps)])
+    scored = []
+    for x in itertools.product(*axes):
+        x = list(x)
+        if task.feasible(x):
+            scored.append((task.objective(x), x))
+    scored.sort(key=lambda item: item[0])
+    best = scored[0][0]
+    for value, x in scored[:polish_from]:
+        step = [(p.high - p.low) / (cont_steps - 1) for p in task.params]
+        while max(s for s, p in zip(step, task.params) if p.kind == "float") > 1e-7 * max(
+                p.high - p.low for p in task.params):
+            improved = False
+            for i, p in enumerate(task.params):
+                if p.kind != "float":
+                    continue
+                for sign in (1, -1):
+                    y = list(x)
+                    y[i] = min(max(y[i] + sign * step[i], p.low), p.high)
+                    if task.feasible(y):
+                        v = task.objective(y)
+                        if v < value:
+                            value, x, improved = v, y, True
+            if not improved:
+                step = [s / 2 for s in step]
+        best = min(best, value)
+    return best
+
+
+FAMILIES = ("smooth2", "smooth6", "smooth10", "mixed", "kinetics")
+TASKS = {t.name: t for t in (Camel2, Rosenbrock2, Hartmann6, Ellipsoid6, Ellipsoid10, Styblinski10, Solvent,
+                             Catalyst, Discrete, Consecutive, Parallel)}
