@@ -8,7 +8,7 @@ PYTHON ?= python3
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 LOCK := requirements.lock
-EXTRAS := .[test,ros,gp]
+EXTRAS := .[test,ros]
 
 # DDS stays on loopback in every process started from here (SPEC section 6), with the fast-discovery profile.
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST

@@ -32,13 +32,15 @@ setup(
         "matplotlib>=3.7",
         # the dashboard's plots: plotly.js, served from this package's copy (the page works offline)
         "plotly>=5",
+        # the default surrogate (general.surrogate portfolio) and gp/auto: BoTorch (GPyTorch, SciPy) on the torch above
+        "botorch>=0.12",
     ],
     extras_require={
         # selenium drives Debian's chromium (chromium-driver) in the dashboard's browser tests
         "test": ["pytest>=8", "hypothesis>=6", "ruff>=0.5", "selenium>=4.10"],
         "ros": ["ros-jazzy-rclpy", "ros-jazzy-common-interfaces", "ros-jazzy-rmw-fastrtps-cpp"],
-        # general.surrogate gp/auto: BoTorch (GPyTorch, SciPy) on the torch above
-        "gp": ["botorch>=0.12"],
+        # kept so that `pip install gryffin_ros[gp]` of earlier instructions still works; BoTorch is a dependency now
+        "gp": [],
     },
     entry_points={
         "console_scripts": [

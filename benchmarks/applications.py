@@ -7,9 +7,11 @@
   sampling strategies), and `dynamic-2s`: dynamic descriptors with the paper's two alternating strategies.
 
     python benchmarks/applications.py [--seeds 20] [--processes 2] [--data ../shared/data] [--out benchmarks/results]
-        [--flow genetic,adam,gp,auto]           flow-reactor variants: the kernel density with the Genetic (the
-                                                example's) or the Adam optimizer; the GP or auto surrogate with Adam
-        [--redox dynamic,static,no,dynamic-2s]  redox variants (default: the first three)
+        [--flow default,genetic,adam,gp,auto]   flow-reactor variants: the example as shipped (the default
+                                                surrogate, Genetic); the kernel density (the paper's model) with the
+                                                Genetic or the Adam optimizer; the GP or auto surrogate with Adam
+        [--redox dynamic,static,no,dynamic-2s,dynamic-kde]  redox variants (default: the first three); all but
+                                                dynamic-kde (the paper's kernel density) use the default surrogate
 
 Per-run results go to <out>/applications_runs.json (resumable); the table to applications.md, plots to
 applications_flow.png and applications_redox.png.
@@ -33,10 +35,12 @@ from gryffin_ros.paths import share_path
 BUDGET = 100
 BEST_REDOX = ("R1_0", "R3_7", "R4_7", "R5_0")
 REDOX_VARIANTS = {"dynamic": "dynamic descriptors", "static": "static descriptors", "no": "no descriptors",
-                  "dynamic-2s": "dynamic descriptors, 2 strategies"}
+                  "dynamic-2s": "dynamic descriptors, 2 strategies",
+                  "dynamic-kde": "dynamic descriptors, kernel density (paper's model)"}
 # flow-reactor variants: overrides of the example's `general` section, and their label
-FLOW_VARIANTS = {"genetic": ({"acquisition_optimizer": "genetic"}, "gryffin_ros (Genetic)"),
-                 "adam": ({"acquisition_optimizer": "adam"}, "gryffin_ros (Adam)"),
+FLOW_VARIANTS = {"default": ({}, "gryffin_ros (default surrogate, Genetic)"),
+                 "genetic": ({"acquisition_optimizer": "genetic", "surrogate": "kde"}, "gryffin_ros (kde, Genetic)"),
+                 "adam": ({"acquisition_optimizer": "adam", "surrogate": "kde"}, "gryffin_ros (kde, Adam)"),
                  "gp": ({"acquisition_optimizer": "adam", "surrogate": "gp"}, "gryffin_ros (GP, Adam)"),
                  "auto": ({"acquisition_optimizer": "adam", "surrogate": "auto"}, "gryffin_ros (auto, Adam)")}
 
@@ -47,6 +51,8 @@ def redox_config(variant: str) -> dict:
     config["general"]["auto_desc_gen"] = variant.startswith("dynamic")
     if variant == "dynamic-2s":
         config["general"]["sampling_strategies"] = 2
+    if variant == "dynamic-kde":
+        config["general"]["surrogate"] = "kde"
     if variant == "no":
         for parameter in config["parameters"]:
             parameter["options"] = list(parameter.pop("descriptors"))

@@ -28,8 +28,9 @@ from surfaces import SURFACES, ContinuousSurface, DiscreteSurface
 from gryffin_ros.planner import Genetic, GryffinRosError, Planner, Random
 from gryffin_ros.planner.strategies import BasePlanner
 
-# adam/genetic: the kernel density under either acquisition optimizer; gp/auto: general.surrogate gp/auto with Adam
-STRATEGIES = ("adam", "genetic", "gp", "auto", "random", "deap")
+# adam/genetic: the kernel density (the paper's model) under either acquisition optimizer; gp/auto/portfolio:
+# general.surrogate gp/auto/portfolio with Adam; default: the planner's defaults (no general section)
+STRATEGIES = ("adam", "genetic", "gp", "auto", "portfolio", "default", "random", "deap")
 TRACE_POINTS = (10, 20, 50, 100)
 
 
@@ -56,10 +57,11 @@ def make_planner(surface: DiscreteSurface | ContinuousSurface, strategy: str, se
         raise ValueError(f"unknown strategy {strategy!r}; choose from {', '.join(STRATEGIES)}")
     config = surface.config(variant) if variant else surface.config()
     if strategy in ("adam", "genetic"):
-        config["general"] = {"acquisition_optimizer": strategy}
+        config["general"] = {"acquisition_optimizer": strategy, "surrogate": "kde"}
         return Planner(config, known_constraints=surface.constraint, seed=seed)
-    if strategy in ("gp", "auto"):
-        config["general"] = {"surrogate": strategy}
+    if strategy in ("gp", "auto", "portfolio", "default"):
+        if strategy != "default":
+            config["general"] = {"surrogate": strategy}
         return Planner(config, known_constraints=surface.constraint, seed=seed)
     cls = Random if strategy == "random" else Genetic
     return cls(config, known_constraints=surface.constraint, seed=seed)

@@ -71,7 +71,7 @@ class GeneralSettings:
     auto_desc_gen: bool = False
     kernel_width: str = "auto"
     concrete_temperature: float = 0.0
-    surrogate: str = "kde"
+    surrogate: str = "portfolio"
     dist_param: float = 0.5
 
 
@@ -86,7 +86,7 @@ _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
 _GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"},
                     "obj_transform": {"sqrt", "cbrt", "square", "identity"},
                     "feas_approach": {"fwa", "fia", "fca"}, "kernel_width": {"auto", "spacing", "gryffin"},
-                    "surrogate": {"kde", "gp", "auto"}}
+                    "surrogate": {"portfolio", "kde", "gp", "auto"}}
 
 
 @dataclass

@@ -47,7 +47,7 @@ try:
     from gpytorch.constraints import GreaterThan, Interval
     from gpytorch.kernels import MaternKernel, ScaleKernel
     from gpytorch.mlls import ExactMarginalLogLikelihood
-except ImportError as _error:  # the GP is an extra: `pip install gryffin_ros[gp]`
+except ImportError as _error:  # a dependency of the package; a broken install is reported when a GP is first needed
     _IMPORT_ERROR: ImportError | None = _error
 else:
     _IMPORT_ERROR = None
@@ -56,8 +56,8 @@ else:
 def require_botorch() -> None:
     """Raise a ConfigError that says how to install the GP's libraries when they are missing."""
     if _IMPORT_ERROR is not None:
-        raise ConfigError(f"general.surrogate 'gp'/'auto' needs BoTorch (pip install 'gryffin_ros[gp]'): "
-                          f"{_IMPORT_ERROR}")
+        raise ConfigError(f"general.surrogate 'portfolio' (the default), 'gp' and 'auto' need BoTorch, which could "
+                          f"not be imported (pip install 'botorch>=0.12', or general.surrogate: kde): {_IMPORT_ERROR}")
 
 
 class Features:

@@ -163,6 +163,46 @@ def test_auto_keeps_the_kernel_density_on_plateaus():
     assert all("fewer than 5 distinct" in p.meta["surrogate_reason"] for p in made[1:])
 
 
+def bowl3(p):
+    return (p["x0"] - 0.3) ** 2 + (p["x1"] - 0.6) ** 2 + (p["x2"] - 0.5) ** 2
+
+
+def config3(**general):
+    return {"parameters": [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(3)],
+            "objectives": [{"name": "y", "goal": "min"}], "general": general}
+
+
+def test_portfolio_is_the_default_and_its_first_model_follows_the_shape_of_the_space():
+    """No surrogate key: the portfolio. With 3 continuous parameters it starts from the GP (also before the models
+    can be compared), with 2 from the kernel density; every proposal says which model made it and why."""
+    assert Planner(config3()).config.general.surrogate == "portfolio"
+    three = Planner(config3(), seed=0)
+    made = run(three, 4, bowl3)
+    assert [p.meta["surrogate"] for p in made[1:]] == ["gp"] * 3
+    assert all("3 continuous parameter(s), GP first" in p.meta["surrogate_reason"] for p in made[1:])
+    two = Planner({**config("kde"), "general": {}}, seed=0)
+    made = run(two, 4, bowl)
+    assert [p.meta["surrogate"] for p in made[1:]] == ["kde"] * 3
+    assert all("kernel density first" in p.meta["surrogate_reason"] for p in made[1:])
+
+
+def test_portfolio_leaves_its_first_model_only_on_clear_evidence(monkeypatch):
+    """With the GP first, the kernel density takes over only when its held-out ranking is better by more than the
+    score's sampling error: a kernel density that ranks the observations perfectly takes over, one that ranks them
+    like the GP does not."""
+    from gryffin_ros.planner.surrogates.kernel_density import KernelDensity
+    planner = Planner(config3(), seed=1)
+    run(planner, 12, bowl3)
+    merits = planner.merits([o for o in planner.observations if not o.failed])
+    monkeypatch.setattr(KernelDensity, "leave_one_out", lambda self: np.asarray(merits))
+    meta = planner.ask()[0].meta
+    assert meta["surrogate"] == "kde" and meta["loo_rank_correlation"]["kde"] == 1.0
+    assert "kernel density clearly better" in meta["surrogate_reason"]
+    monkeypatch.setattr(KernelDensity, "leave_one_out", lambda self: -np.asarray(merits))
+    meta = planner.ask()[0].meta
+    assert meta["surrogate"] == "gp" and "kernel density not clearly better" in meta["surrogate_reason"]
+
+
 def test_gp_proposals_survive_a_restart_exactly():
     """Hyperparameters are refitted from the same first observations after a restart, so a restored planner proposes
     what the running one does, also between refits (25 observations: fitted to the first 24)."""
@@ -176,8 +216,9 @@ def test_gp_proposals_survive_a_restart_exactly():
 
 def test_missing_botorch_is_a_config_error(monkeypatch):
     monkeypatch.setattr(gp_module, "_IMPORT_ERROR", ImportError("No module named 'botorch'"))
-    with pytest.raises(ConfigError, match=r"needs BoTorch \(pip install 'gryffin_ros\[gp\]'\)"):
-        Planner(config("gp"))
+    for setting in ("gp", "portfolio", "auto"):
+        with pytest.raises(ConfigError, match=r"need BoTorch.*pip install 'botorch>=0.12', or general.surrogate: kde"):
+            Planner(config(setting))
     Planner(config("kde"))  # the kernel density does not need it
 
 
@@ -187,7 +228,7 @@ def test_unknown_surrogate_is_refused():
 
 
 @settings(max_examples=12, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
-@given(problem=problems(), surrogate=st.sampled_from(["gp", "auto"]), optimizer=st.sampled_from(["adam", "genetic"]),
+@given(problem=problems(), surrogate=st.sampled_from(["gp", "auto", "portfolio"]), optimizer=st.sampled_from(["adam", "genetic"]),
        seed=st.integers(0, 2**31))
 def test_gp_proposals_are_always_feasible_in_bounds_and_typed(problem, surrogate, optimizer, seed):
     specs, texts, _, _ = problem
@@ -235,3 +276,14 @@ def test_posterior_agrees_with_botorch_also_after_believed_points(categorical):
             with torch.no_grad():
                 fantasy = model(inputs).mean  # standardized, like model.train_targets
             model = model.get_fantasy_model(inputs, fantasy)
+
+
+def test_hyperparameters_are_fitted_to_the_best_and_a_seeded_draw_of_the_rest_beyond_fit_max():
+    from gryffin_ros.planner.surrogates.gaussian_process import FIT_BEST, FIT_MAX, fit_subset
+    y = np.random.default_rng(0).random(FIT_MAX + 200)
+    assert np.array_equal(fit_subset(y[:FIT_MAX], seed=1), np.arange(FIT_MAX))  # small campaigns: every observation
+    subset = fit_subset(y, seed=1)
+    assert len(subset) == FIT_MAX and len(set(subset)) == FIT_MAX and np.all(np.diff(subset) > 0)
+    assert set(np.argsort(y)[:FIT_BEST]) <= set(subset)  # the best ones are always in
+    assert np.array_equal(subset, fit_subset(y, seed=1))  # the same draw after a restart
+    assert not np.array_equal(subset, fit_subset(y, seed=2))
