@@ -3,7 +3,7 @@ NaN (a failed experiment) and counts toward the budget. Reports evaluations unti
 1-d ordinal descriptor (discrete parameters) and without descriptors (categorical options).
 
     python benchmarks/unknown_constraints.py [--seeds 100] [--processes 2] [--out benchmarks/results]
-                                             [--concrete-temperature C]
+                                             [--concrete-temperature C] [--surrogate kde|gp|auto|portfolio]
 
 Per-run results are kept in <out>/unknown_constraints_runs.json, so an interrupted run resumes.
 """
@@ -23,28 +23,31 @@ from surfaces import DISCRETE_SURFACES, OPTIONS
 ANCHOR = {"slope": 15.2, "sphere": 14.7, "michalewicz": 23.4, "camel": 48.6}
 
 
-def config(variant: str, temperature: float | None = None) -> dict:
+def config(variant: str, temperature: float | None = None, surrogate: str | None = None) -> dict:
     if variant == "ordinal":
         parameters = [{"name": n, "type": "discrete", "low": 0, "high": OPTIONS - 1} for n in ("x0", "x1")]
     else:
         parameters = [{"name": n, "type": "categorical", "options": [f"x_{i}" for i in range(OPTIONS)]}
                       for n in ("x0", "x1")]
     out = {"parameters": parameters, "objectives": [{"name": "y", "goal": "min"}]}
-    if temperature is not None:
-        out["general"] = {"concrete_temperature": temperature}
+    general = {"concrete_temperature": temperature} if temperature is not None else {}
+    if surrogate is not None:
+        general["surrogate"] = surrogate
+    if general:
+        out["general"] = general
     return out
 
 
-def run(job: tuple[str, str, int, float | None]) -> tuple[str, str, int, int, int]:
+def run(job: tuple[str, str, int, float | None, str | None]) -> tuple[str, str, int, int, int]:
     """-> (surface, variant, seed, evaluations until the optimum, failed evaluations)."""
     import torch
 
     from gryffin_ros.planner import Planner
     torch.set_num_threads(1)
-    surface_name, variant, seed, temperature = job
+    surface_name, variant, seed, temperature, surrogate = job
     surface = DISCRETE_SURFACES[surface_name]
     optimum = surface.optimum()
-    planner = Planner(config(variant, temperature), seed=seed)
+    planner = Planner(config(variant, temperature, surrogate), seed=seed)
     failed = 0
     for evaluation in range(1, OPTIONS * OPTIONS + 1):
         (proposal,) = planner.ask()
@@ -64,12 +67,15 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results")
     parser.add_argument("--concrete-temperature", type=float, default=None,
                         help="general.concrete_temperature (default: the planner's); results go to files of their own")
+    parser.add_argument("--surrogate", default=None,
+                        help="general.surrogate (default: the planner's); results go to files of their own")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     suffix = "" if args.concrete_temperature is None else f"_c{args.concrete_temperature:g}"
+    suffix += "" if args.surrogate is None else f"_{args.surrogate}"
     store = args.out / f"unknown_constraints_runs{suffix}.json"
     done = {tuple(r[:3]): r for r in (json.loads(store.read_text()) if store.exists() else [])}
-    jobs = [(s, v, seed, args.concrete_temperature) for s in DISCRETE_SURFACES for v in ("ordinal", "naive")
+    jobs = [(s, v, seed, args.concrete_temperature, args.surrogate) for s in DISCRETE_SURFACES for v in ("ordinal", "naive")
             for seed in range(args.seeds) if (s, v, seed) not in done]
     with Pool(args.processes) as pool:
         for result in pool.imap_unordered(run, jobs):

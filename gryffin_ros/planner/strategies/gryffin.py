@@ -36,6 +36,9 @@ SPACING_FACTOR = 16.0
 AUTO_SPACING_MAX_DIMS = 4
 # Start points: hit-and-run chains from known feasible points, at least WALK_POINTS_PER_SEED points each.
 WALK_POINTS_PER_SEED = 8
+# Floor of P(feasible) in the GP's constrained EI (log EI + log P): a candidate the failure model rules out entirely
+# still ranks, last.
+MIN_PROBABILITY = 1e-12
 
 
 @dataclass
@@ -229,8 +232,14 @@ class Planner(BasePlanner):
             candidates, alpha = candidates[keep], alpha[keep]
         if feasibility is not None:
             general = self.config.general
-            alpha = combine(alpha, feasibility.probability(candidates), general.feas_approach, general.feas_param,
-                            feasibility.fraction_failed)
+            probability = feasibility.probability(candidates)
+            if general.feas_approach == "fwa" and getattr(acquisition, "log_scale", False):
+                # the GP's EI weighted by P(feasible) itself (constrained EI, Gardner et al. 2014), in log space: its
+                # min-max rescaled value is nearly flat where EI is small, and failing regions kept their weight
+                alpha = alpha - np.log(np.maximum(probability, MIN_PROBABILITY))
+            else:
+                alpha = combine(alpha, probability, general.feas_approach, general.feas_param,
+                                feasibility.fraction_failed)
         return candidates, alpha
 
     def _propose_gp(self, n: int, rng: np.random.Generator, gp: GaussianProcess, start: np.ndarray, exhaustive: bool,

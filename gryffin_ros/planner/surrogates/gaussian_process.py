@@ -255,6 +255,8 @@ class GPAcquisition:
     which the planner's scores never see): the same interface as the kernel acquisition (`evaluate`,
     `value_and_grad`), so Adam/Hill and the genetic optimizer minimize it under the known constraints."""
 
+    log_scale = True  # alpha is -log EI: weighting EI by P(feasible) is adding -log P
+
     def __init__(self, gp: GaussianProcess):
         self.space = gp.space
         self.features = gp.features
