@@ -287,3 +287,27 @@ def test_hyperparameters_are_fitted_to_the_best_and_a_seeded_draw_of_the_rest_be
     assert set(np.argsort(y)[:FIT_BEST]) <= set(subset)  # the best ones are always in
     assert np.array_equal(subset, fit_subset(y, seed=1))  # the same draw after a restart
     assert not np.array_equal(subset, fit_subset(y, seed=2))
+
+
+def test_with_failures_the_gp_weights_expected_improvement_itself_by_the_probability_of_success():
+    """fwa with the GP: -log EI - log P (constrained EI), so halving P(feasible) costs log 2 whatever EI is; the
+    kernel acquisition keeps Gryffin's rescaled -(1 - a) P."""
+    class Acquisition:
+        def __init__(self, log_scale):
+            self.log_scale = log_scale
+
+        def evaluate(self, X):
+            return np.array([3.0, 1.0, 7.0])  # -log EI
+
+    class Feasibility:
+        fraction_failed = 0.5
+
+        def probability(self, X):
+            return np.array([0.5, 0.25, 1.0])
+
+    planner = Planner(config("gp"), seed=0)
+    start = np.array([[0.1, 0.1], [0.5, 0.5], [0.9, 0.9]])
+    _, alpha = planner._candidates(Acquisition(True), start, True, None, np.random.default_rng(0), Feasibility())
+    np.testing.assert_allclose(alpha, [3.0 + np.log(2), 1.0 + np.log(4), 7.0], rtol=1e-12)
+    _, alpha = planner._candidates(Acquisition(False), start, True, None, np.random.default_rng(0), Feasibility())
+    np.testing.assert_allclose(alpha, [-(1 - 1 / 3) * 0.5, -1.0 * 0.25, 0.0], rtol=1e-12)
