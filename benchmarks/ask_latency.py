@@ -1,7 +1,10 @@
 """Median ask() latency of the Planner vs the number of observations n and the dimension d (paper SI setup: all
 parameters continuous in [0, 1], optionally constrained by sum(x) <= 0.5 d), for the Adam and Genetic optimizers.
 
-    python benchmarks/ask_latency.py [--repeats 5] [--out benchmarks/results/ask_latency.md]
+    python benchmarks/ask_latency.py [--repeats 5] [--surrogate kde] [--out benchmarks/results/ask_latency.md]
+
+--surrogate: general.surrogate of every planner (default kde, the paper's model, which the stored tables measure; the
+default portfolio at lab scale: benchmarks/lab_scale.py).
 
 With --applications: the shipped examples instead (flow reactor, redox candidates with dynamic and static
 descriptors), after n random feasible experiments measured by their emulators
@@ -29,11 +32,12 @@ def objective(x: np.ndarray) -> float:
     return float(np.sum(np.sin(5 * x) + x ** 2))
 
 
-def median_ask(n: int, d: int, optimizer: str, constrained: bool, repeats: int, seed: int = 0) -> float:
+def median_ask(n: int, d: int, optimizer: str, constrained: bool, repeats: int, seed: int = 0,
+               surrogate: str = "kde") -> float:
     config = {
         "parameters": [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(d)],
         "objectives": [{"name": "y", "goal": "min"}],
-        "general": {"acquisition_optimizer": optimizer},
+        "general": {"acquisition_optimizer": optimizer, "surrogate": surrogate},
         "constraints": [" + ".join(f"x{i}" for i in range(d)) + f" <= {0.5 * d}"] if constrained else [],
     }
     planner = Planner(config, seed=seed)
@@ -59,14 +63,15 @@ def median_timed_asks(planner: Planner, repeats: int, measured) -> float:
     return statistics.median(times)
 
 
-def median_application_ask(example: str, general: dict, n: int, repeats: int, seed: int = 0) -> float:
+def median_application_ask(example: str, general: dict, n: int, repeats: int, seed: int = 0,
+                           surrogate: str = "kde") -> float:
     """Median ask() seconds of a shipped example after n random feasible experiments measured by its emulator."""
     from gryffin_ros.emulators import FlowReactorEmulator, RedoxEmulator
     from gryffin_ros.paths import share_path
     from gryffin_ros.planner.config import load_config, read_config
     examples = share_path("examples")
     config = read_config(examples / example)
-    config["general"].update(general)
+    config["general"].update({"surrogate": surrogate, **general})
     planner = Planner(load_config(config, examples), seed=seed)
     emulator = FlowReactorEmulator(seed=seed) if example.startswith("flow") else RedoxEmulator()
     names = [o.name for o in planner.objectives]
@@ -91,6 +96,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--applications", action="store_true", help="the shipped examples instead of the grid")
+    parser.add_argument("--surrogate", default="kde")
     parser.add_argument("--out", type=Path)
     args = parser.parse_args()
     results = Path(__file__).parent / "results"
@@ -98,18 +104,18 @@ def main() -> None:
         args.out = args.out or results / "ask_latency_applications.md"
         rows = ["| example | n = 30 | n = 100 |", "|---|---|---|"]
         for label, example, general in APPLICATIONS:
-            cells = [f"{median_application_ask(example, general, n, args.repeats):.3f}" for n in (30, 100)]
+            cells = [f"{median_application_ask(example, general, n, args.repeats, surrogate=args.surrogate):.3f}" for n in (30, 100)]
             rows.append(f"| {label} | " + " | ".join(cells) + " |")
             print(rows[-1], flush=True)
     else:
         args.out = args.out or results / "ask_latency.md"
         rows = ["| n | d | Adam | Adam, constrained | Genetic | Genetic, constrained |", "|---|---|---|---|---|---|"]
         for n, d in GRID:
-            cells = [f"{median_ask(n, d, opt, c, args.repeats):.3f}" for opt in ("adam", "genetic")
+            cells = [f"{median_ask(n, d, opt, c, args.repeats, surrogate=args.surrogate):.3f}" for opt in ("adam", "genetic")
                      for c in (False, True)]
             rows.append(f"| {n} | {d} | " + " | ".join(cells) + " |")
             print(rows[-1], flush=True)
-    header = (f"Median ask() seconds over {args.repeats} asks; {platform.processor() or platform.machine()}, "
+    header = (f"Median ask() seconds over {args.repeats} asks, surrogate {args.surrogate}; {platform.processor() or platform.machine()}, "
               f"{os.cpu_count()} cores, torch {torch.__version__} ({torch.get_num_threads()} threads).\n\n")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(header + "\n".join(rows) + "\n")

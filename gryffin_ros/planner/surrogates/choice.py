@@ -22,10 +22,11 @@ SURROGATES = ("portfolio", "kde", "gp", "auto")
 # `auto` compares the GP with the kernel density once the successful experiments have this many distinct results.
 AUTO_MIN_OBSERVATIONS = 5
 # `portfolio` starts from the GP when the space has at least this many continuous parameters, from the kernel density
-# otherwise. Measured (benchmarks/README.md, "Problem portfolio"): the kernel density wins on the paper's 2-D
-# rugged and plateau surfaces and on small finite spaces, where the GP needs 4-5x more evaluations (Sphere, Michalewicz);
-# from 3 continuous dims on, smooth lab objectives favour the GP, and beyond 4 the kernel density keeps Gryffin's
-# narrow kernels and is close to random search.
+# otherwise. Measured (benchmarks/README.md, "Problem portfolio" and "Surrogates on the paper's surfaces"): the GP
+# alone needs 4-5x more evaluations on the paper's 2-D plateau and rugged surfaces (Sphere, Michalewicz), where the
+# kernel density first and the comparison keep the best of both; with 3+ continuous dims (the flow reactor, the
+# kinetics and smooth 6-D/10-D problems) the GP wins, and beyond 4 the kernel density keeps Gryffin's narrow kernels
+# and is close to random search.
 PORTFOLIO_GP_MIN_CONTINUOUS = 3
 
 
@@ -46,8 +47,8 @@ class SurrogateChoice:
     def gaussian_process(self, X: np.ndarray, successful: Sequence[Observation],
                          descriptors: Mapping[int, np.ndarray]) -> GaussianProcess:
         """The GP of the untransformed merits, conditioned on every successful experiment, with hyperparameters
-        fitted to the first `fit_size(n)` of them (at most FIT_MAX of those: `fit_subset`; cached; learned descriptors change with every observation, so with
-        them every ask fits). Fits are seeded by the campaign seed and their size alone, so they never change the
+        fitted to the first `fit_size(n)` of them (at most FIT_MAX of those, `fit_subset`; cached; learned descriptors
+        change with every observation, so with them every ask fits). Fits are seeded by the campaign seed and their size alone, so they never change the
         draws of the rest of the ask."""
         from .gaussian_process import FIT_MAX, GaussianProcess, fit_size, fit_subset
 
