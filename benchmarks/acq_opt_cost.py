@@ -31,7 +31,8 @@ NUM_OBS = (10, 100, 200, 300, 400, 500)
 
 def make_planner(d: int, n: int, constrained: bool, optimizer: str, seed: int) -> Planner:
     config = {"parameters": [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(d)],
-              "objectives": [{"name": "y", "goal": "min"}], "general": {"acquisition_optimizer": optimizer}}
+              "objectives": [{"name": "y", "goal": "min"}],
+              "general": {"acquisition_optimizer": optimizer, "surrogate": "kde"}}  # the paper's acquisition
 
     @vectorized
     def half_sum(columns):

@@ -37,7 +37,8 @@ def radius_for(fraction: float, d: int) -> float:
 def campaign(d: int, fraction: float, asks: int, walk: bool, shape: str = "ball", seed: int = 0) -> dict:
     names = [f"x{i}" for i in range(d)]
     config = {"parameters": [{"name": n, "type": "continuous", "low": 0, "high": 1} for n in names],
-              "objectives": [{"name": "y", "goal": "min"}]}
+              "objectives": [{"name": "y", "goal": "min"}],
+              "general": {"surrogate": "kde"}}  # the model the stored tables measured (start points are shared)
     if shape == "ball":
         r = radius_for(fraction, d)
         centre = 0.5
