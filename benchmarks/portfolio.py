@@ -11,8 +11,9 @@ interrupted run resumes and `--aggregate` alone rebuilds the table. Peers' virtu
 
 Score of a run: normalized regret (best - reference) / (best of the common initial design - reference), 1 = no
 progress past the initial points, 0 = the reference (the closed-form optimum, or a dense grid search refined by a
-coordinate search, or the best value any run found if that is lower). A family's score is the mean over its tasks
-and seeds; its s.e. is that of the per-seed means over the family's tasks.
+coordinate search, or the best value any run found if that is lower). A family's score is the mean of its tasks'
+mean regrets; its s.e. is sqrt(sum of the tasks' squared s.e.) / number of tasks (tasks are independent runs; a peer
+may have fewer seeds on some tasks: the table says how many).
 """
 
 from __future__ import annotations
@@ -116,10 +117,11 @@ def aggregate(out: Path, tasks: list[str], seeds: list[int], peers: list[str]) -
         for peer in peers:
             if not all((t, peer) in regrets for t in members):
                 continue
-            common = sorted(set.intersection(*(set(regrets[(t, peer)]) for t in members)))
-            per_seed = [statistics.fmean(regrets[(t, peer)][s] for t in members) for s in common]
-            m, se = mean_se(per_seed)
-            fam[peer] = {"regret": m, "se": se, "ask_cpu_median_s": statistics.median(
+            tasks_of = [result["tasks"][t]["peers"][peer] for t in members]
+            m = statistics.fmean(v["regret"] for v in tasks_of)
+            se = math.sqrt(sum(v["se"] ** 2 for v in tasks_of)) / len(tasks_of)
+            fam[peer] = {"regret": m, "se": se, "seeds": sorted({v["seeds"] for v in tasks_of}),
+                         "ask_cpu_median_s": statistics.median(
                 result["tasks"][t]["peers"][peer]["ask_cpu_median_s"] for t in members)}
         result["families"][family] = {"tasks": members, "peers": fam}
     return result
@@ -137,8 +139,10 @@ def table(result: dict) -> str:
         cells = []
         for p in peers:
             v = f["peers"].get(p)
-            cells.append("—" if v is None else (f"**{fmt(v['regret'], v['se'])}**" if v["regret"] == best
-                                                 else fmt(v["regret"], v["se"])))
+            seeds = "" if v is None or v["seeds"] == [len(result["seeds"])] else \
+                f" ({'/'.join(map(str, v['seeds']))} seeds)"
+            cells.append("—" if v is None else (f"**{fmt(v['regret'], v['se'])}**{seeds}" if v["regret"] == best
+                                                 else fmt(v["regret"], v["se"]) + seeds))
         lines.append(f"| {family} ({', '.join(f['tasks'])}) | " + " | ".join(cells) + " |")
     lines.append("| median CPU per ask (s), per family: " + "; ".join(result["families"]) + " | " + " | ".join(
         " / ".join(f"{f['peers'][p]['ask_cpu_median_s']:.2f}" if p in f["peers"] else "—"
