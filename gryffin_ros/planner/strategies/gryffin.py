@@ -244,11 +244,15 @@ class Planner(BasePlanner):
 
     def _propose_gp(self, n: int, rng: np.random.Generator, gp: GaussianProcess, start: np.ndarray, exhaustive: bool,
                     feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray) -> np.ndarray:
-        """n points by the GP's expected improvement; pending experiments and the batch's earlier proposals enter the
-        GP as believed results (kriging believer), so a batch spreads out without Gryffin's strategies. The
-        acquisition is optimized once per ask; each further point of a batch is the best of those candidates under
-        the updated belief."""
-        gp.believe(chosen)
+        """n points by the GP's expected improvement; failed and pending experiments and the batch's earlier proposals
+        enter the GP as believed results (kriging believer), so they are not proposed again and a batch spreads out
+        without Gryffin's strategies. The acquisition is optimized once per ask; each further point of a batch is the
+        best of those candidates under the updated belief."""
+        # failed experiments enter as believed results too: the GP learns nothing of the objective from them, so
+        # without this their neighbourhood keeps its expected improvement and only P(feasible) holds the planner back
+        failed = observed[np.array([o.failed for o in self.observations], dtype=bool)] if feasibility is not None \
+            else observed[:0]
+        gp.believe(np.concatenate([failed, chosen]))
         optimizer = self.optimizer()
         candidates, alpha = self._candidates(gp.acquisition(), start, exhaustive, optimizer, rng, feasibility)
         points = []
