@@ -1,6 +1,7 @@
 """Lab-scale ask times of the default planner (issue #20, item 3), one thread, on a constrained smooth problem:
 
-- a warm ask at n = 1000 observations, d = 10 (and the first ask of a fresh planner on those observations);
+- warm asks around n = 1000 observations, d = 10 (the median of 10 consecutive asks, n = 996 ... 1005, and the
+  slowest of them), and the first ask of a fresh planner on 995 observations;
 - a batch of 8 at n = 200, d = 6;
 - a batch of 96 (a well plate) at n = 500, d = 6, and how spread out it is: the smallest pairwise distance of its
   points (unit cube) against that of 96 random feasible points (median over 20 draws).
@@ -8,7 +9,7 @@
     .venv/bin/python benchmarks/lab_scale.py [--surrogate NAME] [--repeats 3] [--out benchmarks/results/lab_scale.md]
 
 Observations are random feasible points with their objective values, told in one call; "warm" = the planner has
-answered an ask at n - 1 and is told one more result (what a running campaign does).
+answered the previous ask and is told its result (what a running campaign does).
 """
 
 from __future__ import annotations
@@ -23,6 +24,9 @@ import numpy as np
 import torch
 
 from gryffin_ros.planner import Planner
+
+
+WARM_ASKS = 10
 
 
 def problem(d: int, surrogate: str | None) -> dict:
@@ -84,19 +88,24 @@ def main() -> None:
     label = a.surrogate or "default"
     rows = []
 
-    first, warm, meta = [], [], []
+    first, warm, slowest, meta = [], [], [], []
     for seed in range(a.repeats):
-        planner, _ = planner_with(999, 10, a.surrogate, seed)
+        planner, _ = planner_with(995, 10, a.surrogate, seed)
         t, proposals = timed_ask(planner, 1)
         first.append(t)
-        tell_result(planner, proposals[0])
-        t, proposals = timed_ask(planner, 1)
-        warm.append(t)
+        times = []
+        for _ in range(WARM_ASKS):  # n = 996 ... 1005: a campaign's asks, one of them refits the hyperparameters
+            tell_result(planner, proposals[0])
+            t, proposals = timed_ask(planner, 1)
+            times.append(t)
+        warm.append(statistics.median(times))
+        slowest.append(max(times))
         meta.append(proposals[0].meta)
-        print(f"n=1000 d=10 seed {seed}: first {first[-1]:.2f} s, warm {warm[-1]:.2f} s, meta {meta[-1]}",
-              flush=True)
-    rows.append(("warm ask, n = 1000, d = 10", "≤ 1 s", statistics.median(warm)))
-    rows.append(("first ask, n = 1000, d = 10", "≤ 5 s", statistics.median(first)))
+        print(f"n=1000 d=10 seed {seed}: first {first[-1]:.2f} s, warm median {warm[-1]:.2f} s, slowest "
+              f"{slowest[-1]:.2f} s, meta {meta[-1]}", flush=True)
+    rows.append((f"warm ask, n = 996–1005, d = 10 (median of {WARM_ASKS} asks)", "≤ 1 s", statistics.median(warm)))
+    rows.append(("slowest of those (the one that refits the hyperparameters)", "—", statistics.median(slowest)))
+    rows.append(("first ask, n = 995, d = 10", "≤ 5 s", statistics.median(first)))
 
     batch8 = []
     for seed in range(a.repeats):

@@ -128,7 +128,7 @@ def aggregate(out: Path, tasks: list[str], seeds: list[int], peers: list[str]) -
 
 
 def fmt(m: float, se: float) -> str:
-    return f"{m:.3f} ± {se:.3f}"
+    return f"{m:.3f}" if math.isnan(se) else f"{m:.3f} ± {se:.3f}"  # one seed: no s.e.
 
 
 def table(result: dict) -> str:
@@ -140,7 +140,7 @@ def table(result: dict) -> str:
         for p in peers:
             v = f["peers"].get(p)
             seeds = "" if v is None or v["seeds"] == [len(result["seeds"])] else \
-                f" ({'/'.join(map(str, v['seeds']))} seeds)"
+                f" ({'/'.join(map(str, v['seeds']))} seed{'s' if max(v['seeds']) > 1 else ''})"
             cells.append("—" if v is None else (f"**{fmt(v['regret'], v['se'])}**{seeds}" if v["regret"] == best
                                                  else fmt(v["regret"], v["se"]) + seeds))
         lines.append(f"| {family} ({', '.join(f['tasks'])}) | " + " | ".join(cells) + " |")

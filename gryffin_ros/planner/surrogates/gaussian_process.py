@@ -216,7 +216,7 @@ class Posterior:
         with torch.no_grad():
             self.X = model.train_inputs[0].detach()
             self.y = model.train_targets.detach()
-            self.best = float(self.y.min())  # the best observed merit; believed points never change it
+            self.best = float(self.y.min())  # the incumbent: the best merit, observed or believed
             K = self.kernel(self.X).to_dense() + self.noise * torch.eye(len(self.X), dtype=DTYPE)
             self.L = torch.linalg.cholesky(K)
             self._update_weights()
@@ -247,6 +247,9 @@ class Posterior:
                 L = torch.zeros((n + 1, n + 1), dtype=DTYPE)
                 L[:n, :n], L[n, :n], L[n, n] = self.L, l[:, 0], corner[0]
                 self.L, self.X, self.y = L, torch.cat([self.X, z]), torch.cat([self.y, mean])
+                # a believed result below the incumbent becomes the incumbent (kriging believer): else the expected
+                # improvement next to it stays best - mean > 0 however small the variance, and a batch piles up there
+                self.best = min(self.best, float(mean))
                 self._update_weights()
 
 

@@ -311,3 +311,18 @@ def test_with_failures_the_gp_weights_expected_improvement_itself_by_the_probabi
     np.testing.assert_allclose(alpha, [3.0 + np.log(2), 1.0 + np.log(4), 7.0], rtol=1e-12)
     _, alpha = planner._candidates(Acquisition(False), start, True, None, np.random.default_rng(0), Feasibility())
     np.testing.assert_allclose(alpha, [-(1 - 1 / 3) * 0.5, -1.0 * 0.25, 0.0], rtol=1e-12)
+
+
+def test_a_gp_batch_keeps_its_points_apart():
+    """A batch of 12 from a GP that knows the optimum well: no two of its points are closer than a quarter of the
+    even spacing of 12 points (kriging believer alone put whole batches next to the incumbent)."""
+    from gryffin_ros.planner.strategies.gryffin import batch_spacing
+    planner = Planner(config3(surrogate="gp"), seed=3)
+    rng = np.random.default_rng(3)
+    planner.tell([{**dict(zip(("x0", "x1", "x2"), map(float, x))), "y": bowl3(dict(zip(("x0", "x1", "x2"), x)))}
+                  for x in rng.random((60, 3))])
+    batch = planner.ask(12)
+    X = np.array([[p.params[f"x{i}"] for i in range(3)] for p in batch])
+    d = np.sqrt(((X[:, None] - X[None]) ** 2).sum(-1))[np.triu_indices(12, 1)]
+    assert d.min() >= batch_spacing(planner.space, 12, planner.feasible_fraction.value) - 1e-12
+    assert batch_spacing(planner.space, 12, 1.0) == pytest.approx(0.25 * 12 ** (-1 / 3))
