@@ -278,7 +278,8 @@ class Planner(BasePlanner):
         # without this their neighbourhood keeps its expected improvement and only P(feasible) holds the planner back
         failed = observed[np.array([o.failed for o in self.observations], dtype=bool)] if feasibility is not None \
             else observed[:0]
-        gp.believe(np.concatenate([failed, chosen]))
+        gp.believe(failed, incumbent=False)
+        gp.believe(chosen)
         optimizer = self.optimizer()
         candidates, alpha = self._candidates(gp.acquisition(), start, exhaustive, optimizer, rng, feasibility)
         points = []

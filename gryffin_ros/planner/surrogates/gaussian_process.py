@@ -188,11 +188,12 @@ class GaussianProcess:
             alpha = K_inv @ residual
             return (model.train_targets - alpha / torch.diagonal(K_inv)).numpy()
 
-    def believe(self, X: np.ndarray) -> None:
+    def believe(self, X: np.ndarray, incumbent: bool = True) -> None:
         """Kriging believer: condition the GP on its own posterior mean at points whose results are not known yet
-        (pending experiments, earlier proposals of this batch), so they are not proposed again."""
+        (pending experiments, earlier proposals of this batch), so they are not proposed again; `incumbent=False` for
+        points that will never have a result (failed experiments): they do not become the incumbent."""
         if len(X):
-            self.posterior.believe(self.features.of(X))
+            self.posterior.believe(self.features.of(X), incumbent)
 
     @property
     def posterior(self) -> Posterior:
@@ -234,8 +235,8 @@ class Posterior:
         prior = self.kernel(Z, Z, diag=True)
         return mean, (prior - (v ** 2).sum(0)).clamp_min(1e-12).sqrt()
 
-    def believe(self, Z: torch.Tensor) -> None:
-        """Add inputs Z (B, G) as observations at their posterior mean."""
+    def believe(self, Z: torch.Tensor, incumbent: bool = True) -> None:
+        """Add inputs Z (B, G) as observations at their posterior mean (which may become the incumbent)."""
         with torch.no_grad():
             for z in Z:
                 z = z[None]
@@ -249,7 +250,8 @@ class Posterior:
                 self.L, self.X, self.y = L, torch.cat([self.X, z]), torch.cat([self.y, mean])
                 # a believed result below the incumbent becomes the incumbent (kriging believer): else the expected
                 # improvement next to it stays best - mean > 0 however small the variance, and a batch piles up there
-                self.best = min(self.best, float(mean))
+                if incumbent:
+                    self.best = min(self.best, float(mean))
                 self._update_weights()
 
 
