@@ -104,18 +104,21 @@ def main() -> None:
         args.out = args.out or results / "ask_latency_applications.md"
         rows = ["| example | n = 30 | n = 100 |", "|---|---|---|"]
         for label, example, general in APPLICATIONS:
-            cells = [f"{median_application_ask(example, general, n, args.repeats, surrogate=args.surrogate):.3f}" for n in (30, 100)]
+            cells = [f"{median_application_ask(example, general, n, args.repeats, surrogate=args.surrogate):.3f}"
+                     for n in (30, 100)]
             rows.append(f"| {label} | " + " | ".join(cells) + " |")
             print(rows[-1], flush=True)
     else:
         args.out = args.out or results / "ask_latency.md"
         rows = ["| n | d | Adam | Adam, constrained | Genetic | Genetic, constrained |", "|---|---|---|---|---|---|"]
         for n, d in GRID:
-            cells = [f"{median_ask(n, d, opt, c, args.repeats, surrogate=args.surrogate):.3f}" for opt in ("adam", "genetic")
+            cells = [f"{median_ask(n, d, opt, c, args.repeats, surrogate=args.surrogate):.3f}"
+                     for opt in ("adam", "genetic")
                      for c in (False, True)]
             rows.append(f"| {n} | {d} | " + " | ".join(cells) + " |")
             print(rows[-1], flush=True)
-    header = (f"Median ask() seconds over {args.repeats} asks, surrogate {args.surrogate}; {platform.processor() or platform.machine()}, "
+    header = (f"Median ask() seconds over {args.repeats} asks, surrogate {args.surrogate}; "
+              f"{platform.processor() or platform.machine()}, "
               f"{os.cpu_count()} cores, torch {torch.__version__} ({torch.get_num_threads()} threads).\n\n")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(header + "\n".join(rows) + "\n")

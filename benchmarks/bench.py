@@ -59,7 +59,8 @@ def bench(args: argparse.Namespace) -> int:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--surface", required=True, help="surface name(s), comma separated (e.g. branin,slope)")
-    parser.add_argument("--strategy", default="adam", help="adam, genetic (kde), gp, auto, portfolio, default, random, deap (comma separated)")
+    parser.add_argument("--strategy", default="adam",
+                        help="adam, genetic (kde), gp, auto, portfolio, default, random, deap (comma separated)")
     parser.add_argument("--seeds", type=int, default=10, help="number of runs (seeds from --first-seed)")
     parser.add_argument("--first-seed", type=int, default=0)
     parser.add_argument("--budget", type=int, default=None,

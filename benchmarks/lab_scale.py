@@ -25,7 +25,6 @@ import torch
 
 from gryffin_ros.planner import Planner
 
-
 WARM_ASKS = 10
 
 

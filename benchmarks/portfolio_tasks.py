@@ -207,12 +207,12 @@ class Catalyst(Task):
         self.ligands = names
 
     def feasible(self, x):
-        c, l, T, loading = int(x[0]), int(x[1]), x[2], x[3]
-        return (c, l) not in FORBIDDEN_PAIRS and not (c == 1 and T > 90.0) and loading * T <= 400.0
+        c, ligand, T, loading = int(x[0]), int(x[1]), x[2], x[3]
+        return (c, ligand) not in FORBIDDEN_PAIRS and not (c == 1 and T > 90.0) and loading * T <= 400.0
 
     def objective(self, x):
-        c, l, T, loading = int(x[0]), int(x[1]), x[2], x[3]
-        cone, donor = LIGANDS[self.ligands[l]]
+        c, ligand, T, loading = int(x[0]), int(x[1]), x[2], x[3]
+        cone, donor = LIGANDS[self.ligands[ligand]]
         best_cone = (200.0, 150.0, 240.0, 170.0)[c]
         best_T = (85.0, 70.0, 105.0, 60.0)[c]
         activity = (1.0, 0.9, 0.8, 0.6)[c] * math.exp(-((cone - best_cone) / 50.0) ** 2) * (0.5 + 0.5 * donor)
@@ -236,7 +236,7 @@ class Discrete(Task):
                        Param("conc", "float", 0.05, 1.0), Param("T", "float", 20.0, 80.0)]
 
     def feasible(self, x):
-        stirring, pH, base, conc, T = int(x[0]), int(x[1]), int(x[2]), x[3], x[4]
+        stirring, pH, base, conc = int(x[0]), int(x[1]), int(x[2]), x[3]
         low, high, max_conc = ((7, 12, 0.8), (5, 11, 1.0), (8, 12, 0.5))[base]
         return low <= pH <= high and conc <= max_conc and conc * (1 + stirring) <= 3.0
 

@@ -75,7 +75,8 @@ def main() -> None:
     suffix += "" if args.surrogate is None else f"_{args.surrogate}"
     store = args.out / f"unknown_constraints_runs{suffix}.json"
     done = {tuple(r[:3]): r for r in (json.loads(store.read_text()) if store.exists() else [])}
-    jobs = [(s, v, seed, args.concrete_temperature, args.surrogate) for s in DISCRETE_SURFACES for v in ("ordinal", "naive")
+    jobs = [(s, v, seed, args.concrete_temperature, args.surrogate) for s in DISCRETE_SURFACES
+            for v in ("ordinal", "naive")
             for seed in range(args.seeds) if (s, v, seed) not in done]
     with Pool(args.processes) as pool:
         for result in pool.imap_unordered(run, jobs):

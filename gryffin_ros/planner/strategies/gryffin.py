@@ -22,7 +22,7 @@ from ..surrogates.feasibility import FeasibilityModel, combine
 from ..surrogates.kernel_density import KernelDensity
 from .base import BasePlanner
 from .feasible import SPREAD_SEEDS
-from .selection import select, squared_distances
+from .selection import apart, batch_spacing, select
 
 if TYPE_CHECKING:  # the GP module (and BoTorch, ~0.4 s to import) is loaded only by planners that use it
     from ..surrogates.gaussian_process import GaussianProcess, GPAcquisition
@@ -36,35 +36,9 @@ SPACING_FACTOR = 16.0
 AUTO_SPACING_MAX_DIMS = 4
 # Start points: hit-and-run chains from known feasible points, at least WALK_POINTS_PER_SEED points each.
 WALK_POINTS_PER_SEED = 8
-# A GP batch keeps its points at least this fraction of the even spacing of the batch apart (batch_spacing).
-BATCH_SPACING = 0.25
 # Floor of P(feasible) in the GP's constrained EI (log EI + log P): a candidate the failure model rules out entirely
 # still ranks, last.
 MIN_PROBABILITY = 1e-12
-
-
-def batch_spacing(space, n: int, feasible_fraction: float) -> float:
-    """Least distance (scaled units, non-categorical dims) between two points of one GP batch of n: BATCH_SPACING
-    times the spacing of n points spread evenly over the feasible volume. Kriging-believer EI alone put a plate of 96
-    (n = 500, d = 6) inside a box of side 0.1 around the incumbent (least distance 0.002; random feasible points:
-    0.17)."""
-    dims = sum(p.kind != "categorical" for p in space.parameters)
-    return BATCH_SPACING * (feasible_fraction / max(n, 1)) ** (1.0 / dims) if dims and n > 1 else 0.0
-
-
-def apart(space, candidates: np.ndarray, alpha: np.ndarray, batch: np.ndarray, spacing: float) -> np.ndarray:
-    """alpha with candidates closer than `spacing` to a point already in the batch ruled out (+inf); the spacing is
-    halved until some candidate is left."""
-    if not spacing or not len(batch):
-        return alpha
-    dims = np.array([d for d, p in enumerate(space.parameters) if p.kind != "categorical"], dtype=int)
-    d2 = squared_distances(space.scaled(candidates)[:, dims], space.scaled(batch)[:, dims]).min(axis=1)
-    while spacing > 1e-6:
-        near = d2 < spacing ** 2
-        if not (near | ~np.isfinite(alpha)).all():
-            return np.where(near, np.inf, alpha)
-        spacing /= 2
-    return alpha
 
 
 @dataclass

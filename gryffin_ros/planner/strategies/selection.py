@@ -10,6 +10,8 @@ import numpy as np
 from ..space import SearchSpace
 
 DUPLICATE_DISTANCE = 1e-8
+# A GP batch keeps its points at least this fraction of the even spacing of the batch apart (batch_spacing).
+BATCH_SPACING = 0.25
 
 
 def squared_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -25,12 +27,17 @@ def duplicates(space: SearchSpace, candidates: np.ndarray, reference: np.ndarray
     return (d2 < DUPLICATE_DISTANCE).any(axis=1)
 
 
+def ordered_dims(space: SearchSpace) -> np.ndarray:
+    """The continuous and discrete dims: those with a distance between options."""
+    return np.array([d for d, p in enumerate(space.parameters) if p.kind != "categorical"], dtype=int)
+
+
 def diversity(space: SearchSpace, candidates: np.ndarray, reference: np.ndarray, n_observations: int,
               dist_param: float = 0.5) -> np.ndarray:
     """min(1, mean_d exp(2 (dist_d - char_dist) / range_d)) over continuous/discrete dims, dist_d measured to the
     nearest reference point; ranges are 1 in scaled units and char_dist = 1 / n^dist_param (Gryffin's dist_param,
     default 0.5: 1 / sqrt(n))."""
-    dims = np.array([d for d, p in enumerate(space.parameters) if p.kind != "categorical"], dtype=int)
+    dims = ordered_dims(space)
     if not dims.size or not len(reference):
         return np.ones(len(candidates))
     a, b = space.scaled(candidates)[:, dims], space.scaled(reference)[:, dims]
@@ -53,3 +60,28 @@ def select(space: SearchSpace, candidates: np.ndarray, alpha: np.ndarray, observ
         return int(np.argmin(np.where(allowed, alpha, np.inf)))
     reward = np.where(allowed, np.exp(-(alpha - alpha[allowed].min())), 0.0)  # shifted: same argmax, no overflow
     return int(np.argmax(reward * diversity(space, candidates, reference, len(observed), dist_param)))
+
+
+def batch_spacing(space: SearchSpace, n: int, feasible_fraction: float) -> float:
+    """Least distance (scaled units, non-categorical dims) between two points of one GP batch of n: BATCH_SPACING
+    times the spacing of n points spread evenly over the feasible volume. Kriging-believer EI alone put a plate of 96
+    (n = 500, d = 6) inside a box of side 0.1 around the incumbent (least distance 0.002; random feasible points:
+    0.17)."""
+    dims = len(ordered_dims(space))
+    return BATCH_SPACING * (feasible_fraction / max(n, 1)) ** (1.0 / dims) if dims and n > 1 else 0.0
+
+
+def apart(space: SearchSpace, candidates: np.ndarray, alpha: np.ndarray, batch: np.ndarray,
+          spacing: float) -> np.ndarray:
+    """alpha with candidates closer than `spacing` to a point already in the batch ruled out (+inf); the spacing is
+    halved until some candidate is left."""
+    if not spacing or not len(batch):
+        return alpha
+    dims = ordered_dims(space)
+    d2 = squared_distances(space.scaled(candidates)[:, dims], space.scaled(batch)[:, dims]).min(axis=1)
+    while spacing > 1e-6:
+        near = d2 < spacing ** 2
+        if not (near | ~np.isfinite(alpha)).all():
+            return np.where(near, np.inf, alpha)
+        spacing /= 2
+    return alpha

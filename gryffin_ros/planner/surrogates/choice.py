@@ -48,8 +48,8 @@ class SurrogateChoice:
                          descriptors: Mapping[int, np.ndarray]) -> GaussianProcess:
         """The GP of the untransformed merits, conditioned on every successful experiment, with hyperparameters
         fitted to the first `fit_size(n)` of them (at most FIT_MAX of those, `fit_subset`; cached; learned descriptors
-        change with every observation, so with them every ask fits). Fits are seeded by the campaign seed and their size alone, so they never change the
-        draws of the rest of the ask."""
+        change with every observation, so with them every ask fits). Fits are seeded by the campaign seed and their
+        size alone, so they never change the draws of the rest of the ask."""
         from .gaussian_process import FIT_MAX, GaussianProcess, fit_size, fit_subset
 
         def seed(size: int) -> int:

@@ -242,11 +242,11 @@ class Posterior:
                 z = z[None]
                 cross = self.kernel(z, self.X).to_dense()  # (1, n)
                 mean = self.mean(z) + cross @ self.weights
-                l = torch.linalg.solve_triangular(self.L, cross.T, upper=False)  # (n, 1)
-                corner = (self.kernel(z, z, diag=True) + self.noise - (l ** 2).sum()).clamp_min(1e-12).sqrt()
+                row = torch.linalg.solve_triangular(self.L, cross.T, upper=False)  # (n, 1): the new row of L
+                corner = (self.kernel(z, z, diag=True) + self.noise - (row ** 2).sum()).clamp_min(1e-12).sqrt()
                 n = len(self.X)
                 L = torch.zeros((n + 1, n + 1), dtype=DTYPE)
-                L[:n, :n], L[n, :n], L[n, n] = self.L, l[:, 0], corner[0]
+                L[:n, :n], L[n, :n], L[n, n] = self.L, row[:, 0], corner[0]
                 self.L, self.X, self.y = L, torch.cat([self.X, z]), torch.cat([self.y, mean])
                 # a believed result below the incumbent becomes the incumbent (kriging believer): else the expected
                 # improvement next to it stays best - mean > 0 however small the variance, and a batch piles up there

@@ -228,7 +228,8 @@ def test_unknown_surrogate_is_refused():
 
 
 @settings(max_examples=12, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
-@given(problem=problems(), surrogate=st.sampled_from(["gp", "auto", "portfolio"]), optimizer=st.sampled_from(["adam", "genetic"]),
+@given(problem=problems(), surrogate=st.sampled_from(["gp", "auto", "portfolio"]),
+       optimizer=st.sampled_from(["adam", "genetic"]),
        seed=st.integers(0, 2**31))
 def test_gp_proposals_are_always_feasible_in_bounds_and_typed(problem, surrogate, optimizer, seed):
     specs, texts, _, _ = problem
@@ -316,7 +317,7 @@ def test_with_failures_the_gp_weights_expected_improvement_itself_by_the_probabi
 def test_a_gp_batch_keeps_its_points_apart():
     """A batch of 12 from a GP that knows the optimum well: no two of its points are closer than a quarter of the
     even spacing of 12 points (kriging believer alone put whole batches next to the incumbent)."""
-    from gryffin_ros.planner.strategies.gryffin import batch_spacing
+    from gryffin_ros.planner.strategies.selection import batch_spacing
     planner = Planner(config3(surrogate="gp"), seed=3)
     rng = np.random.default_rng(3)
     planner.tell([{**dict(zip(("x0", "x1", "x2"), map(float, x))), "y": bowl3(dict(zip(("x0", "x1", "x2"), x)))}
