@@ -135,9 +135,10 @@ class Gryffin:
             general = raw.get("general")
             raw["general"] = {**(general if isinstance(general, Mapping) else {}), "feasible_fraction": frac_feas}
         self.silent = bool(silent)
-        general = raw.get("general")
-        # Gryffin's model: the kernel density, unless the config asks for another surrogate
-        raw["general"] = {"surrogate": "kde", **(general if isinstance(general, Mapping) else {})}
+        general = raw.get("general", {})
+        if isinstance(general, Mapping):  # (anything else is left for load_config to refuse)
+            # Gryffin's model: the kernel density, unless the config asks for another surrogate
+            raw["general"] = {"surrogate": "kde", **general}
         self.config: PlannerConfig = load_config(raw, base_dir)
         self.planner = Planner(self.config, known_constraints)
         self.known_constraints = known_constraints

@@ -111,6 +111,15 @@ def test_unknown_keys_and_bad_values_stay_errors(square, patch, message):
     assert message in str(info.value)
 
 
+def test_the_drop_in_keeps_gryffins_model_and_still_refuses_a_general_that_is_no_mapping(square):
+    """Gryffin's kernel density unless the config names a surrogate; setting that default must not swallow a
+    malformed `general` (it did once: `general: 5` was replaced instead of refused)."""
+    assert Gryffin(config_dict=square).config.general.surrogate == "kde"
+    assert Gryffin(config_dict={**square, "general": {"surrogate": "gp"}}).config.general.surrogate == "gp"
+    with pytest.raises(ConfigError, match="'general' must be a mapping"):
+        Gryffin(config_dict={**square, "general": 5})
+
+
 @pytest.mark.parametrize("transform, expected", [
     (None, lambda f: f), ("identity", lambda f: f), ("sqrt", np.sqrt), ("cbrt", np.cbrt), ("square", np.square),
 ])
