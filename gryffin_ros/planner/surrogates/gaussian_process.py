@@ -138,7 +138,6 @@ class GaussianProcess:
         require_botorch()
         self.space = space
         self.features = Features(space, descriptors)
-        self.best = float(np.min(y))
         train_X = self.features.of(X).detach()
         train_Y = torch.as_tensor(np.asarray(y, dtype=float)[:, None], dtype=DTYPE)
         likelihood = get_gaussian_likelihood_with_lognormal_prior()
@@ -178,15 +177,14 @@ class GaussianProcess:
 
     def leave_one_out(self) -> np.ndarray:
         """(n,) leave-one-out predictive means of the training targets, with the fitted hyperparameters
-        (Rasmussen & Williams eq. 5.12), in standardized units."""
-        model = self.model
+        (Rasmussen & Williams eq. 5.12), in standardized units. The posterior's Cholesky factor serves: its leading
+        n x n block is that of the training covariance, whatever points were believed after it."""
+        post, n = self.posterior, len(self.model.train_targets)
         with torch.no_grad():
-            X = model.train_inputs[0]
-            K = model.covar_module(X).to_dense() + model.likelihood.noise * torch.eye(len(X), dtype=DTYPE)
-            residual = model.train_targets - model.mean_module(X)
-            K_inv = torch.cholesky_inverse(torch.linalg.cholesky(K))
-            alpha = K_inv @ residual
-            return (model.train_targets - alpha / torch.diagonal(K_inv)).numpy()
+            y, X = post.y[:n], post.X[:n]
+            K_inv = torch.cholesky_inverse(post.L[:n, :n])
+            alpha = K_inv @ (y - post.mean(X))
+            return (y - alpha / torch.diagonal(K_inv)).numpy()
 
     def believe(self, X: np.ndarray, incumbent: bool = True) -> None:
         """Kriging believer: condition the GP on its own posterior mean at points whose results are not known yet
