@@ -1,6 +1,6 @@
 """Load on the planner node over ROS 2 (loopback): (a) 1000 valid observations in a burst (accept_unsolicited), as
-one list message and as 1000 single messages, timed until all are stored; (b) 50 concurrent ~/recommend calls;
-(c) ~/get_status latency while the optimizer works.
+one list message and as 1000 single messages, timed until all are stored; (b) 50 concurrent ~/json/recommend calls;
+(c) ~/json/get_status latency while the optimizer works.
 
     python benchmarks/load.py [--out benchmarks/results/load.md]
 """
@@ -95,9 +95,9 @@ def main() -> None:
             env={**os.environ, "ROS_LOG_DIR": str(work)}, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         rclpy.init()
         node = rclpy.create_node("load_client")
-        publisher = node.create_publisher(String, "/gryffin_planner/observations", KEEP_ALL)
-        recommend = node.create_client(Trigger, "/gryffin_planner/recommend")
-        status = node.create_client(Trigger, "/gryffin_planner/get_status")
+        publisher = node.create_publisher(String, "/gryffin_planner/json/observations", KEEP_ALL)
+        recommend = node.create_client(Trigger, "/gryffin_planner/json/recommend")
+        status = node.create_client(Trigger, "/gryffin_planner/json/get_status")
         executor = MultiThreadedExecutor(num_threads=2)
         executor.add_node(node)
         threading.Thread(target=executor.spin, daemon=True).start()

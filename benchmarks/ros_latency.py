@@ -1,5 +1,6 @@
-"""Latency of the planner node over ROS 2 on loopback: ~/recommend round trip, observation -> event, and the wall
-time of a 30-experiment closed-loop flow-reactor campaign (emulator experiment time 0).
+"""Latency of the planner node over ROS 2 on loopback, typed interfaces and JSON bridge side by side (one planner
+node each, same config): recommend round trip, observation -> event; how long a cancel of a long Recommend goal
+takes to end it; the wall time of a 30-experiment closed-loop flow-reactor campaign (emulator experiment time 0).
 
     python benchmarks/ros_latency.py [--calls 20] [--out benchmarks/results/ros_latency.md]
 """
@@ -24,68 +25,147 @@ from gryffin_ros.rosenv import ros_environment
 os.environ.update(ros_environment())
 
 import rclpy  # noqa: E402
+import yaml  # noqa: E402
+from gryffin_ros_msgs.action import Recommend  # noqa: E402
+from gryffin_ros_msgs.msg import Event, ObjectiveValue, Observation  # noqa: E402
+from rclpy.action import ActionClient  # noqa: E402
 from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
 from gryffin_ros.nodes.qos import EVENTS_QOS, OBSERVATIONS_QOS  # noqa: E402
+from gryffin_ros.nodes.typed import parameter_values  # noqa: E402
+
+# the long recommendation that is canceled: the genetic optimizer over six continuous parameters, 400 points
+LONG_CONFIG = {"name": "long", "parameters": [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0}
+                                              for i in range(6)],
+               "objectives": [{"name": "y", "goal": "min"}], "constraints": ["x0 + x1 < 1.5"],
+               "general": {"acquisition_optimizer": "genetic", "surrogate": "kde"}}
 
 
-def call(client, timeout: float = 60.0):
-    future = client.call_async(Trigger.Request())
+def wait(future, timeout: float = 120.0):
     done = threading.Event()
     future.add_done_callback(lambda _: done.set())
     if not done.wait(timeout):
-        raise TimeoutError(client.srv_name)
+        raise TimeoutError("no answer")
     return future.result()
 
 
-def node_latencies(calls: int, workdir: Path) -> tuple[list[float], list[float]]:
-    config = share_path("examples") / "flow_reactor.yaml"
-    planner = subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-p",
-                                f"config:={config}", "-p", f"storage:={workdir / 'bench.sqlite'}", "-p", "seed:=0",
-                                "-p", "auto_propose:=false"], env={**os.environ, "ROS_LOG_DIR": str(workdir)},
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    rclpy.init()
-    node = rclpy.create_node("bench_client")
-    events: dict[str, float] = {}
-    arrived = threading.Event()
+def start_planner(config: Path, workdir: Path, name: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-r",
+                             f"__ns:=/{name}", "-p", f"config:={config}", "-p",
+                             f"storage:={workdir / (name + '.sqlite')}", "-p", "seed:=0", "-p", "auto_propose:=false"],
+                            env={**os.environ, "ROS_LOG_DIR": str(workdir)}, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
 
-    def on_event(msg: String) -> None:
-        events.setdefault(json.loads(msg.data).get("experiment_id", ""), time.perf_counter())
-        arrived.set()
-    node.create_subscription(String, "/gryffin_planner/events", on_event, EVENTS_QOS)
-    publisher = node.create_publisher(String, "/gryffin_planner/observations", OBSERVATIONS_QOS)
-    recommend = node.create_client(Trigger, "/gryffin_planner/recommend")
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    threading.Thread(target=executor.spin, daemon=True).start()
-    try:
-        if not recommend.wait_for_service(timeout_sec=60):
+
+class Lab:
+    """One client of both interfaces; `typed` chooses which one a measurement uses."""
+
+    def __init__(self, ns: str) -> None:
+        self.node = rclpy.create_node(f"bench_client_{ns}")
+        base = f"/{ns}/gryffin_planner"
+        self.events: dict[str, float] = {}
+        self.arrived = threading.Event()
+        self.node.create_subscription(Event, f"{base}/events", lambda m: self._event(m.experiment_id), EVENTS_QOS)
+        self.node.create_subscription(String, f"{base}/json/events",
+                                      lambda m: self._event(json.loads(m.data).get("experiment_id", "")), EVENTS_QOS)
+        self.typed_pub = self.node.create_publisher(Observation, f"{base}/observations", OBSERVATIONS_QOS)
+        self.json_pub = self.node.create_publisher(String, f"{base}/json/observations", OBSERVATIONS_QOS)
+        self.action = ActionClient(self.node, Recommend, f"{base}/recommend")
+        self.trigger = self.node.create_client(Trigger, f"{base}/json/recommend")
+        self.executor = SingleThreadedExecutor()
+        self.executor.add_node(self.node)
+        threading.Thread(target=self.executor.spin, daemon=True).start()
+        if not (self.action.wait_for_server(timeout_sec=120) and self.trigger.wait_for_service(timeout_sec=120)):
             raise TimeoutError("planner node did not start")
-        while publisher.get_subscription_count() == 0:
+        while self.typed_pub.get_subscription_count() == 0 or self.json_pub.get_subscription_count() == 0:
             time.sleep(0.01)
-        round_trips, to_event = [], []
-        for i in range(calls):
+
+    def _event(self, experiment_id: str) -> None:
+        self.events.setdefault(experiment_id, time.perf_counter())
+        self.arrived.set()
+
+    def recommend(self, typed: bool) -> tuple[str, dict]:
+        if typed:
+            goal = wait(self.action.send_goal_async(Recommend.Goal(count=1)))
+            proposal = wait(goal.get_result_async()).result.proposals[0]
+            return proposal.experiment_id, {p.name: p.number for p in proposal.params}
+        proposal = json.loads(wait(self.trigger.call_async(Trigger.Request())).message)["proposals"][0]
+        return proposal["experiment_id"], proposal["params"]
+
+    def observe(self, typed: bool, experiment_id: str, params: dict, objectives: dict) -> float:
+        sent = time.perf_counter()
+        if typed:
+            values = [ObjectiveValue(name=k, value=v) for k, v in objectives.items()]
+            self.typed_pub.publish(Observation(experiment_id=experiment_id, params=parameter_values(params),
+                                               objectives=values))
+        else:
+            self.json_pub.publish(String(data=json.dumps({"experiment_id": experiment_id, "params": params,
+                                                          "objectives": objectives})))
+        while experiment_id not in self.events:
+            self.arrived.wait(timeout=1.0)
+            self.arrived.clear()
+        return self.events[experiment_id] - sent
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+
+
+def stop(process: subprocess.Popen) -> None:
+    process.send_signal(signal.SIGINT)
+    process.wait(timeout=60)
+
+
+def node_latencies(calls: int, workdir: Path) -> dict[str, tuple[list[float], list[float]]]:
+    config = share_path("examples") / "flow_reactor.yaml"
+    results = {}
+    for typed in (True, False):
+        name = "typed" if typed else "json"
+        planner = start_planner(config, workdir, name)
+        lab = Lab(name)
+        try:
+            round_trips, to_event = [], []
+            for i in range(calls):
+                start = time.perf_counter()
+                experiment_id, params = lab.recommend(typed)
+                round_trips.append(time.perf_counter() - start)
+                to_event.append(lab.observe(typed, experiment_id, params, {"X1_X2": 0.5 + 0.01 * i, "cost": 0.01}))
+            results[name] = (round_trips, to_event)
+        finally:
+            lab.close()
+            stop(planner)
+    return results
+
+
+def cancel_latencies(repeats: int, workdir: Path) -> list[float]:
+    """Seconds from sending the cancel of a running 400-point Recommend goal to its canceled result."""
+    config = workdir / "long.yaml"
+    config.write_text(yaml.safe_dump(LONG_CONFIG))
+    planner = start_planner(config, workdir, "long")
+    lab = Lab("long")
+    try:
+        for i in range(2):  # a model from here on
+            experiment_id, params = lab.recommend(True)
+            lab.observe(True, experiment_id, params, {"y": float(i)})
+        out = []
+        for _ in range(repeats):
+            optimizing = threading.Event()
+            goal = wait(lab.action.send_goal_async(
+                Recommend.Goal(count=400), feedback_callback=lambda f, seen=optimizing: (
+                    seen.set() if f.feedback.stage in ("optimizing", "selecting") else None)))
+            optimizing.wait(120)
             start = time.perf_counter()
-            response = call(recommend)
-            round_trips.append(time.perf_counter() - start)
-            proposal = json.loads(response.message)["proposals"][0]
-            sent = time.perf_counter()
-            publisher.publish(String(data=json.dumps({"experiment_id": proposal["experiment_id"],
-                                                      "params": proposal["params"],
-                                                      "objectives": {"X1_X2": 0.5 + 0.01 * i, "cost": 0.01}})))
-            while proposal["experiment_id"] not in events:
-                arrived.wait(timeout=1.0)
-                arrived.clear()
-            to_event.append(events[proposal["experiment_id"]] - sent)
-        return round_trips, to_event
+            wait(goal.cancel_goal_async())
+            result = wait(goal.get_result_async())
+            out.append(time.perf_counter() - start)
+            if result.status != 5:
+                raise RuntimeError(f"goal ended with status {result.status}, not canceled")
+        return out
     finally:
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()
-        planner.send_signal(signal.SIGINT)
-        planner.wait(timeout=30)
+        lab.close()
+        stop(planner)
 
 
 def closed_loop_seconds(workdir: Path) -> float:
@@ -100,16 +180,28 @@ def main() -> None:
     parser.add_argument("--calls", type=int, default=20)
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "ros_latency.md")
     args = parser.parse_args()
-    with tempfile.TemporaryDirectory() as tmp:
-        workdir = Path(tmp)
-        round_trips, to_event = node_latencies(args.calls, workdir)
-        loop = closed_loop_seconds(workdir)
+    rclpy.init()
+    try:
+        with tempfile.TemporaryDirectory() as tmp:
+            workdir = Path(tmp)
+            latencies = node_latencies(args.calls, workdir)
+            cancels = cancel_latencies(5, workdir)
+            loop = closed_loop_seconds(workdir)
+    finally:
+        rclpy.try_shutdown()
+
     def ms(values: list[float]) -> str:
         return f"{1000 * statistics.median(values):.1f} ms (max {1000 * max(values):.1f} ms)"
-    text = (f"Planner node over ROS 2 (Fast DDS, loopback), {args.calls} calls, flow-reactor config, 2 cores:\n\n"
-            f"| measure | median |\n|---|---|\n"
-            f"| `~/recommend` round trip (includes one ask) | {ms(round_trips)} |\n"
-            f"| observation published -> `observation_accepted` event received | {ms(to_event)} |\n"
+    typed, bridge = latencies["typed"], latencies["json"]
+    text = (f"Planner node over ROS 2 (Fast DDS, loopback), {args.calls} calls per interface, flow-reactor config, "
+            f"2 cores; median (max):\n\n"
+            f"| measure | typed (gryffin_ros_msgs) | JSON bridge (`~/json/...`) |\n|---|---|---|\n"
+            f"| recommend round trip, one proposal (includes one ask): `Recommend` goal to result vs "
+            f"`~/json/recommend` | {ms(typed[0])} | {ms(bridge[0])} |\n"
+            f"| observation published -> `observation_accepted` event received | {ms(typed[1])} | "
+            f"{ms(bridge[1])} |\n\n"
+            f"| measure | result |\n|---|---|\n"
+            f"| cancel of a running 400-point `Recommend` goal -> canceled result (5 goals) | {ms(cancels)} |\n"
             f"| 30-experiment closed loop, `gryffin-ros campaign --budget 30` (both nodes started) | {loop:.1f} s |\n")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(text)

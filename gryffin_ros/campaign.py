@@ -30,9 +30,13 @@ from typing import Any
 from .planner import Observation, Planner, Proposal
 from .planner.config import PlannerConfig, load_config, read_config
 from .planner.errors import GryffinRosError, ObservationError
+from .planner.reporting import Cancelled, ProgressCallback, reporting
 from .storage import CampaignStore
 
 logger = logging.getLogger(__name__)
+
+# While another proposal holds the planner, a caller with a progress callback hears "waiting" this often.
+WAIT_REPORT_S = 0.25
 
 ConstraintArg = Callable[[dict], bool] | Sequence[Callable[[dict], bool]] | None
 
@@ -60,15 +64,13 @@ class Campaign:
         checked = load_config(raw, base)  # validates; its hash identifies the campaign in the store
         self.name = checked.name
         self.accept_unsolicited = accept_unsolicited
+        self._raw, self._base = checked.raw, base
         self.store = CampaignStore(storage, checked.raw, checked.hash)
         try:
             stored_seed = self.store.get_meta("seed")
             if seed is None and stored_seed is not None:  # a campaign keeps its seed
                 seed = int(stored_seed)
-            tuned = copy.deepcopy(checked.raw)
-            if settings:
-                tuned.setdefault("general", {}).update(settings)
-            config_used = load_config(tuned, base) if settings else checked
+            config_used = self._tuned(settings) if settings else checked
             # a new campaign: the seed given, else the config's, else a random one (the Planner's rule)
             self.planner = Planner(config_used, known_constraints, seed)
             self.store.set_meta("seed", str(self.planner.seed))
@@ -89,6 +91,18 @@ class Campaign:
         self._n_failed = sum(o.failed for o in observations)
         self._best = self.planner.best()
         self._state = "idle"
+
+    def _tuned(self, settings: Mapping[str, Any]) -> PlannerConfig:
+        tuned = copy.deepcopy(self._raw)
+        tuned.setdefault("general", {}).update(settings)
+        return load_config(tuned, self._base)
+
+    def use_settings(self, settings: Mapping[str, Any]) -> None:
+        """Change settings (as `settings` at construction: how to optimize, not what) from the next proposal on;
+        waits for a running one. Raises ConfigError, changing nothing, for a value the config would refuse."""
+        config = self._tuned(settings)
+        with self._planner_lock:
+            self.planner.config = config
 
     # ---- read-outs -----------------------------------------------------------------------------------------
     @property
@@ -227,49 +241,66 @@ class Campaign:
             self._absorb()
 
     # ---- proposals -----------------------------------------------------------------------------------------
-    def propose(self, n: int | None = None, claimed: bool = True,
-                started: Callable[[], None] | None = None) -> list[Proposal]:
+    def propose(self, n: int | None = None, claimed: bool = True, started: Callable[[], None] | None = None,
+                progress: ProgressCallback | None = None) -> list[Proposal]:
         """`n` new proposals (default general.batches), stored before they are returned. `claimed=False` marks
         them as published without being asked for (auto-propose), so that `claim` hands them out later.
-        `started` is called once the optimization has begun (status is then "optimizing")."""
-        with self._planner_lock:
+        `started` is called once the optimization has begun (status is then "optimizing"). `progress(stage,
+        fraction, ready)` is called at checkpoints (stage "waiting" while another proposal runs) and may stop the
+        proposal by raising `Cancelled`: nothing is then stored or pending, and the planner is as before."""
+        self._acquire_planner(progress)
+        try:
+            with reporting(progress):
+                return self._propose(n, claimed, started)
+        finally:
+            self._planner_lock.release()
+
+    def _acquire_planner(self, progress: ProgressCallback | None) -> None:
+        if progress is None:
+            self._planner_lock.acquire()
+            return
+        while not self._planner_lock.acquire(timeout=WAIT_REPORT_S):
+            progress("waiting", 0.0, 0)  # may raise Cancelled: nothing was held
+
+    def _propose(self, n: int | None, claimed: bool, started: Callable[[], None] | None) -> list[Proposal]:
+        with self._state_lock:
+            if self._closed:
+                raise CampaignClosed(f"campaign '{self.name}' is closed; nothing is proposed")
+            self._state = "optimizing"
+        counters = (self.planner.ask_count, self.planner.proposal_count)
+        proposals: list[Proposal] = []
+        try:
+            if started is not None:
+                started()
+            self._absorb()
+            proposals = self.planner.ask(n)
+            self.store.add_proposals(proposals, {"ask_count": str(self.planner.ask_count),
+                                                 "proposal_count": str(self.planner.proposal_count)})
+        except BaseException as exc:
+            if proposals:  # asked but not stored: the planner forgets them, as if never asked
+                self.planner.retract(proposals, *counters)
             with self._state_lock:
-                if self._closed:
-                    raise CampaignClosed(f"campaign '{self.name}' is closed; nothing is proposed")
-                self._state = "optimizing"
-            counters = (self.planner.ask_count, self.planner.proposal_count)
-            proposals: list[Proposal] = []
-            try:
-                if started is not None:
-                    started()
-                self._absorb()
-                proposals = self.planner.ask(n)
-                self.store.add_proposals(proposals, {"ask_count": str(self.planner.ask_count),
-                                                     "proposal_count": str(self.planner.proposal_count)})
-            except BaseException:
-                if proposals:  # asked but not stored: the planner forgets them, as if never asked
-                    self.planner.retract(proposals, *counters)
-                with self._state_lock:
-                    self._state = "error"
-                raise
-            with self._state_lock:
-                self._pending.update((p.experiment_id, p) for p in proposals)
-                if not claimed:
-                    self._unclaimed += [p.experiment_id for p in proposals]
-                self._state = "idle"
-            self._absorb()  # what arrived while optimizing
+                self._state = "idle" if isinstance(exc, Cancelled) else "error"
+            raise
+        with self._state_lock:
+            self._pending.update((p.experiment_id, p) for p in proposals)
+            if not claimed:
+                self._unclaimed += [p.experiment_id for p in proposals]
+            self._state = "idle"
+        self._absorb()  # what arrived while optimizing
         return proposals
 
-    def claim(self, n: int | None = None, started: Callable[[], None] | None = None) -> list[Proposal]:
+    def claim(self, n: int | None = None, started: Callable[[], None] | None = None,
+              progress: ProgressCallback | None = None) -> list[Proposal]:
         """`n` proposals for someone who asks (the node's recommend): unclaimed pending ones first, each handed out
-        once, then new ones (`started` as in `propose`)."""
+        once, then new ones (`started` and `progress` as in `propose`)."""
         n = self.config.general.batches if n is None else n
         with self._state_lock:
             taken, self._unclaimed = self._unclaimed[:n], self._unclaimed[n:]
             handed = [self._pending[i] for i in taken]
         if len(handed) < n:
             try:
-                handed += self.propose(n - len(handed), started=started)
+                handed += self.propose(n - len(handed), started=started, progress=progress)
             except BaseException:
                 with self._state_lock:  # nothing was handed out: the unclaimed stay unclaimed
                     self._unclaimed[:0] = [i for i in taken if i in self._pending]

@@ -172,9 +172,11 @@ class Gryffin:
             if missing:
                 raise ObservationError(f"observations[{i}]: missing objective(s) {missing} (NaN or None for a failed "
                                        "experiment)")
-            # 0-d arrays (np.squeeze of a measurement, as Olympus reports them) are plain numbers to Gryffin
-            out.append({k: (v.item() if isinstance(v, np.ndarray) and v.ndim == 0 else v)
-                        for k, v in item.items() if k in keep})
+            # 0-d arrays (np.squeeze of a measurement, as Olympus reports them) are plain numbers to Gryffin, and
+            # NaN is Gryffin's word for a failed experiment: None here
+            row = {k: (v.item() if isinstance(v, np.ndarray) and v.ndim == 0 else v) for k, v in item.items()
+                   if k in keep}
+            out.append({k: (None if k in objectives and _is_nan(v) else v) for k, v in row.items()})
         return out
 
     def recommend(self, observations: Sequence[Mapping[str, Any]] | None = None,
@@ -304,3 +306,7 @@ class Gryffin:
             "the list you pass to recommend(), so write them out yourself (e.g. csv.DictWriter), or run the campaign "
             "with gryffin_ros.planner.Planner and gryffin_ros.storage.CampaignStore, exported by "
             "`gryffin-ros export STORE --csv FILE`")
+
+
+def _is_nan(value: Any) -> bool:
+    return isinstance(value, (float, np.floating)) and bool(np.isnan(value))

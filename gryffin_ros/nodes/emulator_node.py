@@ -1,7 +1,8 @@
 """ROS 2 emulator nodes that close the loop in simulation: `flow_reactor_emulator` (the C60 flow reactor BNN) and
 `redox_emulator` (DFT lookup of benzothiadiazole candidates). Each runs every new proposed experiment through its
-emulator and publishes one observation per experiment, optionally after a simulated experiment time and with
-injected failures (objectives null); every output goes into `meta`."""
+emulator and publishes one typed observation per experiment, optionally after a simulated experiment time and with
+injected failures (failed = true); every output goes into `meta_json`. Names are relative (`<planner>/proposals`),
+so `-r __ns:=/lab2` moves an emulator and its planner together."""
 
 from __future__ import annotations
 
@@ -13,11 +14,10 @@ from typing import Any
 
 import numpy as np
 from rclpy.node import Node
-from std_msgs.msg import String
 
-from .. import messages
 from ..emulators import FlowReactorEmulator, RedoxEmulator
 from ..planner import GryffinRosError
+from . import typed
 from .qos import LATCHED_QOS, OBSERVATIONS_QOS
 from .runner import declare, run
 
@@ -25,6 +25,8 @@ COMMON = {
     "experiment_time_s": (0.0, "simulated duration of one experiment, in seconds"),
     "failure_rate": (0.0, "probability that an experiment fails (reported with objectives null)"),
     "seed": (-1, "random seed of the emulator; -1 = random"),
+    "planner": ("gryffin_planner", "the planner node whose proposals this emulator runs (a name relative to this "
+                                   "node's namespace, or absolute)"),
 }
 KINDS: dict[str, dict[str, Any]] = {
     "flow_reactor_emulator": {
@@ -65,32 +67,36 @@ class EmulatorNode(Node):
         self.rng = np.random.default_rng(None if seed is None else seed + 1)
         self.queue: deque[dict] = deque()
         self.seen: set[str] = set()
-        self.reported: dict[str, str] = {}  # experiment_id -> the observation message sent
+        self.reported: dict[str, typed.Observation] = {}  # experiment_id -> the observation message sent
         self.running: tuple[dict, float] | None = None
-        self.publisher = self.create_publisher(String, "/gryffin_planner/observations", OBSERVATIONS_QOS)
-        self.create_subscription(String, "/gryffin_planner/proposals", self._on_proposals, LATCHED_QOS)
+        planner = p["planner"].rstrip("/")
+        if not planner:
+            raise GryffinRosError("parameter 'planner' must name the planner node (default gryffin_planner)")
+        self.publisher = self.create_publisher(typed.Observation, f"{planner}/observations", OBSERVATIONS_QOS)
+        self.create_subscription(typed.Proposals, f"{planner}/proposals", self._on_proposals, LATCHED_QOS)
         self.create_timer(0.005, self._work)
 
-    def _on_proposals(self, msg: String) -> None:
-        try:
-            document = messages.parse("proposals", msg.data)
-        except GryffinRosError as exc:
-            self.get_logger().warning(f"ignoring proposals message: {exc}")
-            return
-        for proposal in document["proposals"]:
-            if proposal["experiment_id"] in self.reported:
+    def _on_proposals(self, msg: typed.Proposals) -> None:
+        for proposal in msg.proposals:
+            experiment_id = proposal.experiment_id
+            if experiment_id in self.reported:
                 # announced again (the planner restarted): the report may have been lost, so send it again; a
                 # planner that has it already rejects the copy as a duplicate
-                self.publisher.publish(String(data=self.reported[proposal["experiment_id"]]))
+                self.publisher.publish(self.reported[experiment_id])
                 continue
-            if proposal["experiment_id"] in self.seen:
+            if experiment_id in self.seen:
                 continue
-            missing = [n for n in self.emulator.parameters if n not in proposal["params"]]
+            try:
+                params = typed.params_of(proposal.params)
+            except GryffinRosError as exc:
+                self.get_logger().warning(f"proposal {experiment_id}: {exc}; skipped")
+                continue
+            missing = [n for n in self.emulator.parameters if n not in params]
             if missing:
-                self.get_logger().warning(f"proposal {proposal['experiment_id']} lacks {missing}; skipped")
+                self.get_logger().warning(f"proposal {experiment_id} lacks {missing}; skipped")
                 continue
-            self.seen.add(proposal["experiment_id"])
-            self.queue.append(proposal)
+            self.seen.add(experiment_id)
+            self.queue.append({"experiment_id": experiment_id, "params": params})
 
     def _work(self) -> None:
         if self.running is None:
@@ -107,13 +113,10 @@ class EmulatorNode(Node):
             self.get_logger().warning(f"cannot emulate {proposal['experiment_id']}: {exc!r}; reported as failed")
             result = None
         failed = result is None or self.rng.random() < self.failure_rate
-        observation = {"experiment_id": proposal["experiment_id"], "params": proposal["params"],
-                       "objectives": None if failed else {k: result[k] for k in self.objectives}}
-        if result is not None:
-            observation["meta"] = result
-        text = messages.dump("observation", observation)
-        self.reported[proposal["experiment_id"]] = text
-        self.publisher.publish(String(data=text))
+        observation = typed.observation_message(proposal["experiment_id"], proposal["params"],
+                                                None if failed else {k: result[k] for k in self.objectives}, result)
+        self.reported[proposal["experiment_id"]] = observation
+        self.publisher.publish(observation)
 
 
 def _main(kind: str) -> Callable[[list[str] | None], int]:

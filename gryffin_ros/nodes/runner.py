@@ -32,13 +32,16 @@ STOP_POLL_S = 0.1
 _TYPE_NAMES = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list"}
 
 
-def declare(node: Node, parameters: dict[str, tuple[Any, str]]) -> dict[str, Any]:
-    """Declare the node's parameters (name: (default, description)) and return their values; a value of the wrong
-    type (`-p batch_size:=three`) is a GryffinRosError saying what is expected, not rclpy's traceback."""
+def declare(node: Node, parameters: dict[str, tuple[Any, str]], read_only: tuple[str, ...] = ()
+            ) -> dict[str, Any]:
+    """Declare the node's parameters (name: (default, description)) and return their values; those in `read_only`
+    refuse a set at run time. A value of the wrong type (`-p batch_size:=three`) is a GryffinRosError saying what
+    is expected, not rclpy's traceback."""
     values = {}
     for name, (default, description) in parameters.items():
         try:
-            node.declare_parameter(name, default, ParameterDescriptor(description=description))
+            node.declare_parameter(name, default, ParameterDescriptor(description=description,
+                                                                      read_only=name in read_only))
         except InvalidParameterTypeException:
             expected = _TYPE_NAMES.get(type(default), type(default).__name__)
             raise GryffinRosError(f"parameter '{name}' must be {expected} ({description}); default "

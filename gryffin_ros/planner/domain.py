@@ -52,14 +52,14 @@ class Proposal:
 
 
 def objective_value(name: str, value: Any) -> float | None:
-    """A reported objective as a float, or None for a failed experiment (None or NaN); infinities are refused."""
+    """A reported objective as a float, or None for a failed experiment. NaN and infinities are refused: a failure
+    is said explicitly (None here, null in JSON, failed = true in a typed message), never as a number."""
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ObservationError(f"objective '{name}' must be a number or null, got {value!r}")
     value = float(value)
-    if math.isnan(value):
-        return None
-    if math.isinf(value):
-        raise ObservationError(f"objective '{name}' = {value} is not finite; report a failed experiment as null")
+    if not math.isfinite(value):
+        raise ObservationError(f"objective '{name}' = {value} is not a result; report a failed experiment as None "
+                               "(JSON null, failed = true in a typed observation)")
     return value

@@ -50,7 +50,8 @@ def flow_feasible(p: dict) -> bool:
 
 
 class Client(Node):
-    """The lab side: publishes observations, records events/status/proposals, calls the services."""
+    """The lab side over the JSON bridge (~/json/...): publishes observations, records events/status/proposals,
+    calls the services."""
 
     def __init__(self) -> None:
         super().__init__("test_lab_client")
@@ -58,12 +59,12 @@ class Client(Node):
         self.proposals: list[dict] = []
         self.statuses: list[dict] = []
         self.lock = threading.Lock()
-        self.publisher = self.create_publisher(String, "/gryffin_planner/observations", OBSERVATIONS_QOS)
-        self.create_subscription(String, "/gryffin_planner/events", self._record(self.events), EVENTS_QOS)
-        self.create_subscription(String, "/gryffin_planner/proposals", self._record(self.proposals), LATCHED_QOS)
-        self.create_subscription(String, "/gryffin_planner/status", self._record(self.statuses), LATCHED_QOS)
-        self.recommend_client = self.create_client(Trigger, "/gryffin_planner/recommend")
-        self.status_client = self.create_client(Trigger, "/gryffin_planner/get_status")
+        self.publisher = self.create_publisher(String, "/gryffin_planner/json/observations", OBSERVATIONS_QOS)
+        self.create_subscription(String, "/gryffin_planner/json/events", self._record(self.events), EVENTS_QOS)
+        self.create_subscription(String, "/gryffin_planner/json/proposals", self._record(self.proposals), LATCHED_QOS)
+        self.create_subscription(String, "/gryffin_planner/json/status", self._record(self.statuses), LATCHED_QOS)
+        self.recommend_client = self.create_client(Trigger, "/gryffin_planner/json/recommend")
+        self.status_client = self.create_client(Trigger, "/gryffin_planner/json/get_status")
 
     def _record(self, sink: list):
         def callback(msg: String) -> None:
@@ -147,15 +148,15 @@ def node_env(tmp_path: Path) -> dict[str, str]:
 
 
 class PlannerProcess:
-    def __init__(self, tmp_path: Path, config: dict, **params):
+    def __init__(self, tmp_path: Path, config: dict, ros_args: tuple[str, ...] = (), **params):
         self.config_path = tmp_path / f"config-{len(list(tmp_path.glob('config-*')))}.yaml"
         self.config_path.write_text(yaml.safe_dump(config))
         params.setdefault("storage", str(tmp_path / "campaign.sqlite"))
         params.setdefault("seed", 0)
-        args = ["--ros-args", "-p", f"config:={self.config_path}"]
+        args = ["--ros-args", *ros_args, "-p", f"config:={self.config_path}"]
         for key, value in params.items():
             args += ["-p", f"{key}:={str(value).lower() if isinstance(value, bool) else value}"]
-        self.log_path = tmp_path / "planner.log"
+        self.log_path = tmp_path / f"planner-{self.config_path.stem}.log"
         self.log = open(self.log_path, "a")
         self.process = subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.planner_node", *args],
                                         env=node_env(tmp_path), stdout=self.log, stderr=subprocess.STDOUT)
@@ -183,15 +184,20 @@ def start_planner(tmp_path, lab_session):
     (a node of an earlier test may still be known to DDS for a moment, so its service is no sign of the new one)."""
     started: list[PlannerProcess] = []
 
-    def start(config: dict = FLOW_CONFIG, wait: bool = True, **params) -> PlannerProcess:
+    def start(config: dict = FLOW_CONFIG, wait: bool = True, ros_args: tuple[str, ...] = (),
+              **params) -> PlannerProcess:
         with lab_session.lock:
             seen = len(lab_session.statuses)
-        process = PlannerProcess(tmp_path, config, **params)
+        process = PlannerProcess(tmp_path, config, ros_args, **params)
         started.append(process)
         deadline = time.monotonic() + HANG_S
         while wait:
+            if params.get("autostart") is False and "autostart is off" in process.output():
+                break  # unconfigured: nothing is published yet
             with lab_session.lock:
-                if len(lab_session.statuses) > seen and "campaign '" in process.output():
+                # the default namespace's status reached the lab client, or a namespaced node says it is active
+                if ((len(lab_session.statuses) > seen or ros_args) and "campaign '" in process.output()
+                        and ": active" in process.output()):
                     break
             assert process.process.poll() is None, f"planner node exited: {process.output()}"
             assert time.monotonic() < deadline, "planner node did not come up"

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..acquisition.kernel import Acquisition
 from ..constraints import KnownConstraints
+from ..reporting import report
 
 BETA1, BETA2, EPSILON = 0.9, 0.999, 1e-8
 # Only the best REFINE_FRACTION of the start points (by their acquisition value, at least REFINE_MIN) are refined; the
@@ -53,6 +54,7 @@ class AdamHillOptimizer:
         m, v = np.zeros((len(X), c.size)), np.zeros((len(X), c.size))
         alpha = None if c.size else acquisition.evaluate(X)
         for step in range(1, self.steps + 1):
+            report("optimizing", (step - 1) / self.steps)
             if c.size:
                 alpha = self._adam_step(acquisition, X, alpha, active, still, m, v, step)
             if f.size:

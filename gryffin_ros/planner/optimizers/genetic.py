@@ -17,6 +17,7 @@ from deap import base, creator, tools
 
 from ..acquisition.kernel import Acquisition
 from ..constraints import KnownConstraints, line_limits
+from ..reporting import report
 from ..space import SearchSpace
 
 TOURNAMENT_SIZE = 3
@@ -144,7 +145,8 @@ class GeneticOptimizer:
         population = to_individuals(start, acquisition.evaluate(start))
         n_elite = max(1, int(round(ELITE_FRACTION * len(population))))
         with seeded_python_random(rng):
-            for _ in range(self.generations):
+            for generation in range(self.generations):
+                report("optimizing", generation / self.generations)
                 elites = tools.selBest(population, n_elite)
                 selected = tools.selTournament(population, len(population) - n_elite, TOURNAMENT_SIZE)
                 parents = np.array(selected)

@@ -195,12 +195,18 @@ class BasePlanner:
     # ---- proposals -------------------------------------------------------------------------------------------
     def ask(self, n: int | None = None) -> list[Proposal]:
         """The next n proposals (default: general.batches); each feasible, none repeating a point of a finite space
-        that was observed or is pending."""
+        that was observed or is pending. Progress goes to the callback of `reporting.reporting`, which may stop the
+        ask by raising `Cancelled` (the planner is then as before the ask)."""
         n = self.config.general.batches if n is None else n
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise ValueError(f"n must be a positive integer, got {n!r}")
         rng = self._rng()
-        points, strategies, meta = self._propose(n, rng)
+        proposal_count = self._proposal_count
+        try:
+            points, strategies, meta = self._propose(n, rng)
+        except BaseException:  # stopped (Cancelled) or failed: the next ask draws what this one would have
+            self._proposal_count = proposal_count
+            raise
         self._ask_count += 1
         proposals = []
         for strategy, params in zip(strategies, self.space.to_params(points)):

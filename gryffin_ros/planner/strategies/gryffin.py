@@ -16,6 +16,7 @@ from ..config import PlannerConfig
 from ..constraints.sampling import perturb, rejection_sample, spread_seeds
 from ..domain import ConstraintArg, Observation
 from ..optimizers import AcquisitionOptimizer, make_optimizer
+from ..reporting import report
 from ..surrogates.choice import SurrogateChoice
 from ..surrogates.descriptors import LearnedDescriptors, learn_many
 from ..surrogates.feasibility import FeasibilityModel, combine
@@ -190,6 +191,7 @@ class Planner(BasePlanner):
         observed = self.observed_points()
         chosen = self.pending_points()
         generator = torch.Generator().manual_seed(int(rng.integers(2**63)))
+        report("models", 0.0)
         models = self._surrogates(generator)
         successful = models.successful
         feasibility = models.feasibility
@@ -199,6 +201,7 @@ class Planner(BasePlanner):
             return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n, {}
         X, merits, descriptors, density = models.X, models.merits, models.descriptors, models.density
         gp, meta = self.surrogate_choice.choose(X, merits, successful, density, descriptors)
+        report("optimizing", 0.0)
         start, exhaustive = self.start_points(rng, X[int(np.argmin(merits))], X)
         if gp is not None:
             return self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen), [None] * n, meta
@@ -206,7 +209,8 @@ class Planner(BasePlanner):
         optimizer = self.optimizer()
         refined: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         points, strategies = [], []
-        for _ in range(n):
+        for i in range(n):
+            report("selecting", i / n, i)
             s = float(values[self._proposal_count % len(values)])
             self._proposal_count += 1
             if s not in refined:
@@ -259,6 +263,7 @@ class Planner(BasePlanner):
         points = []
         spacing = batch_spacing(self.space, n, self.feasible_fraction.value)
         for i in range(n):
+            report("selecting", i / n, i)
             if i:  # the believed points changed the acquisition: the optimized candidates are scored again (an
                 # optimization per point made a plate of 96 take a minute)
                 candidates, alpha = self._candidates(gp.acquisition(), candidates, True, optimizer, rng, feasibility)

@@ -102,11 +102,18 @@ def test_bad_observations_are_rejected_and_nothing_is_stored(unit_square_config,
 
 def test_failed_experiments_are_stored_but_left_out_of_the_regression(unit_square_config):
     planner = Planner(unit_square_config, seed=0)
-    planner.tell([{"x0": 0.1, "x1": 0.1, "y": None}, {"x0": 0.2, "x1": 0.2, "y": float("nan")},
+    planner.tell([{"x0": 0.1, "x1": 0.1, "y": None}, {"x0": 0.2, "x1": 0.2, "y": None},
                   {"x0": 0.3, "x1": 0.3, "y": 2.0}])
     assert [o.failed for o in planner.observations] == [True, True, False]
     assert planner.best().objectives == {"y": 2.0}
     assert len(planner.ask(2)) == 2
+
+
+def test_nan_is_not_a_result_a_failure_is_said_with_none(unit_square_config):
+    planner = Planner(unit_square_config, seed=0)
+    with pytest.raises(ObservationError, match="report a failed experiment as None"):
+        planner.tell({"x0": 0.2, "x1": 0.2, "y": float("nan")})
+    assert not planner.observations
 
 
 def test_duplicate_experiment_ids_are_rejected(unit_square_config):

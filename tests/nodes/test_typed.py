@@ -1,0 +1,291 @@
+"""The ROS-native planner node over real DDS, seen from a separate rclpy process that imports gryffin_ros_msgs: the
+lifecycle, the Recommend action (feedback, result, cancel), typed observations and events, parameters, diagnostics,
+namespaces."""
+
+from __future__ import annotations
+
+import math
+import sqlite3
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from gryffin_ros_msgs.action import Recommend
+from gryffin_ros_msgs.msg import Event, ObjectiveValue, Observation, ParameterValue
+from gryffin_ros_msgs.srv import GetStatus
+from lifecycle_msgs.msg import Transition
+from lifecycle_msgs.srv import ChangeState, GetState
+from rcl_interfaces.msg import Parameter, ParameterType
+from rcl_interfaces.msg import ParameterValue as RosParameterValue
+from rcl_interfaces.srv import GetParameters, SetParameters
+from rclpy.action import ActionClient
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import qos_profile_system_default
+
+from gryffin_ros.nodes.qos import EVENTS_QOS, OBSERVATIONS_QOS
+from gryffin_ros.paths import share_path
+
+from .conftest import FLOW_CONFIG, HANG_S, flow_feasible, node_env
+
+EXAMPLES = share_path("examples")
+# a campaign whose recommendation of many points takes far longer than a cancel needs to arrive (the genetic
+# optimizer over six continuous parameters, 400 points of a batch, each re-scored)
+LONG_CONFIG = {
+    "name": "long_test",
+    "parameters": [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(6)],
+    "objectives": [{"name": "y", "goal": "min"}],
+    "constraints": ["x0 + x1 < 1.5"],
+    "general": {"acquisition_optimizer": "genetic", "surrogate": "kde"},
+}
+
+
+def wait_until(condition, what: str, timeout: float = HANG_S):
+    deadline = time.monotonic() + timeout
+    while not (value := condition()):
+        assert time.monotonic() < deadline, f"timed out waiting for {what}"
+        time.sleep(0.02)
+    return value
+
+
+class TypedLab(Node):
+    """A lab client that uses the typed interfaces of the planner in namespace `ns`."""
+
+    def __init__(self, name: str, ns: str = "") -> None:
+        super().__init__(name)
+        base = f"{ns}/gryffin_planner"
+        self.events: list[Event] = []
+        self.diagnostics: list[DiagnosticArray] = []
+        self.lock = threading.Lock()
+        self.observations = self.create_publisher(Observation, f"{base}/observations", OBSERVATIONS_QOS)
+        self.create_subscription(Event, f"{base}/events", self._keep(self.events), EVENTS_QOS)
+        self.create_subscription(DiagnosticArray, "/diagnostics", self._keep(self.diagnostics), 10)
+        self.recommend = ActionClient(self, Recommend, f"{base}/recommend")
+        self.get_status = self.create_client(GetStatus, f"{base}/get_status")
+        self.change_state = self.create_client(ChangeState, f"{base}/change_state")
+        self.get_state = self.create_client(GetState, f"{base}/get_state")
+        self.set_parameters = self.create_client(SetParameters, f"{base}/set_parameters",
+                                                 qos_profile=qos_profile_system_default)
+        self.get_parameters = self.create_client(GetParameters, f"{base}/get_parameters")
+
+    def _keep(self, sink: list):
+        def callback(msg) -> None:
+            with self.lock:
+                sink.append(msg)
+        return callback
+
+    @staticmethod
+    def wait(future, what: str, timeout: float = HANG_S):
+        wait_until(future.done, what, timeout)
+        return future.result()
+
+    def call(self, client, request, timeout: float = HANG_S):
+        assert client.wait_for_service(timeout_sec=timeout), f"{client.srv_name} not available"
+        return self.wait(client.call_async(request), f"an answer from {client.srv_name}", timeout)
+
+    def state(self) -> str:
+        return self.call(self.get_state, GetState.Request()).current_state.label
+
+    def transition(self, transition_id: int) -> bool:
+        return self.call(self.change_state, ChangeState.Request(transition=Transition(id=transition_id))).success
+
+    def status(self):
+        return self.call(self.get_status, GetStatus.Request()).status
+
+    def send_goal(self, count: int, feedback: list | None = None):
+        assert self.recommend.wait_for_server(timeout_sec=HANG_S), "recommend action server not available"
+        goal = self.wait(self.recommend.send_goal_async(
+            Recommend.Goal(count=count), feedback_callback=None if feedback is None else feedback.append),
+            "the goal's acceptance")
+        return goal
+
+    def recommend_now(self, count: int = 0, feedback: list | None = None):
+        goal = self.send_goal(count, feedback)
+        assert goal.accepted, "goal rejected"
+        return self.wait(goal.get_result_async(), "the recommendation's result")
+
+    def set(self, name: str, value) -> tuple[bool, str]:
+        kinds = {bool: (ParameterType.PARAMETER_BOOL, "bool_value"), int: (ParameterType.PARAMETER_INTEGER,
+                 "integer_value"), str: (ParameterType.PARAMETER_STRING, "string_value")}
+        kind, field = kinds[type(value)]
+        parameter = Parameter(name=name, value=RosParameterValue(type=kind, **{field: value}))
+        result = self.call(self.set_parameters, SetParameters.Request(parameters=[parameter])).results[0]
+        return result.successful, result.reason
+
+    def observation_events(self, count: int) -> list[Event]:
+        def enough():
+            with self.lock:
+                got = [e for e in self.events if e.type.startswith("observation_")]
+            return got if len(got) >= count else None
+        return wait_until(enough, f"{count} observation events")
+
+    def wait_matched(self) -> None:
+        wait_until(lambda: self.observations.get_subscription_count() > 0, "the planner's observation subscription")
+
+
+@pytest.fixture
+def lab(lab_session):
+    """A typed lab client in this test process (rclpy is initialized by the session's JSON client)."""
+    node = TypedLab("typed_lab")
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    thread = threading.Thread(target=executor.spin, daemon=True)
+    thread.start()
+    yield node
+    executor.shutdown()
+    node.destroy_node()
+
+
+def observation_of(proposal, objectives: dict[str, float] | None, **changes) -> Observation:
+    params = [ParameterValue(name=p.name, number=changes.get(p.name, p.number), text=p.text) for p in proposal.params]
+    return Observation(experiment_id=proposal.experiment_id, params=params, failed=objectives is None,
+                       objectives=[ObjectiveValue(name=k, value=v) for k, v in (objectives or {}).items()])
+
+
+def params_dict(proposal) -> dict:
+    return {p.name: (p.text or p.number) for p in proposal.params}
+
+
+def test_a_managed_node_is_configured_and_activated_then_recommends_and_learns(lab, start_planner):
+    start_planner(autostart=False, auto_propose=False)
+    assert lab.state() == "unconfigured"
+    diagnosis = wait_until(lambda: next((d.status[0] for d in list(lab.diagnostics)
+                                         if d.status[0].message == "unconfigured"), None), "diagnostics unconfigured")
+    assert diagnosis.level == DiagnosticStatus.WARN  # not serving
+    assert lab.transition(Transition.TRANSITION_CONFIGURE)
+    assert lab.state() == "inactive"
+    assert lab.transition(Transition.TRANSITION_ACTIVATE)
+    assert lab.state() == "active"
+
+    feedback: list = []
+    outcome = lab.recommend_now(3, feedback)
+    assert outcome.status == 4, outcome  # GoalStatus.STATUS_SUCCEEDED
+    proposals = outcome.result.proposals
+    assert len(proposals) == 3 and all(flow_feasible(params_dict(p)) for p in proposals)
+    assert len({p.experiment_id for p in proposals}) == 3
+    assert all(math.isnan(p.strategy) or -1 <= p.strategy <= 1 for p in proposals)
+    assert feedback and all(0.0 <= f.feedback.progress <= 1.0 for f in feedback)
+    assert lab.status().n_pending == 3
+
+    lab.wait_matched()
+    first, second, third = proposals
+    lab.observations.publish(observation_of(first, {"X1_X2": 0.4}))
+    lab.observations.publish(observation_of(second, {"X1_X2": 0.4}, T=180.0))  # above the bound
+    lab.observations.publish(observation_of(second, {"X1_X2": math.nan}))  # NaN is not a result
+    lab.observations.publish(observation_of(second, None))  # failed: data
+    lab.observations.publish(observation_of(third, {"X1_X2": 0.1}, F_C=150.0, F_S=10.0))  # infeasible
+    events = lab.observation_events(5)
+    assert [(e.type, e.experiment_id) for e in events] == [
+        ("observation_accepted", first.experiment_id), ("observation_rejected", second.experiment_id),
+        ("observation_rejected", second.experiment_id), ("observation_accepted", second.experiment_id),
+        ("observation_rejected", third.experiment_id)]
+    assert "'T' = 180.0 is above its upper bound 150.0" in events[1].reason
+    assert "failed = true" in events[2].reason
+    assert "violate the known constraint" in events[4].reason
+    status = lab.status()
+    assert (status.n_observations, status.n_failed, status.n_pending) == (2, 1, 1)
+    assert status.best[0].experiment_id == first.experiment_id
+
+    def active_diagnosis():
+        for array in reversed(list(lab.diagnostics)):
+            values = {v.key: v.value for v in array.status[0].values}
+            if values.get("observations") == "2":
+                return array.status[0], values
+        return None
+    diagnosis, values = wait_until(active_diagnosis, "diagnostics with the observations")
+    assert values["lifecycle_state"] == "active" and values["pending"] == "1" and values["failed"] == "1"
+    assert diagnosis.level == DiagnosticStatus.WARN and "rejected" in diagnosis.message  # recent rejections
+
+    assert lab.transition(Transition.TRANSITION_DEACTIVATE)
+    assert lab.state() == "inactive"
+    assert lab.transition(Transition.TRANSITION_CLEANUP)
+    assert lab.state() == "unconfigured"
+
+
+def test_a_long_recommendation_is_canceled_and_leaves_nothing_pending(lab, start_planner):
+    start_planner(LONG_CONFIG, auto_propose=False)
+    first = lab.recommend_now(2).result.proposals  # a model exists from here on
+    lab.wait_matched()
+    for i, proposal in enumerate(first):
+        lab.observations.publish(observation_of(proposal, {"y": float(i)}))
+    lab.observation_events(2)
+    feedback: list = []
+    goal = lab.send_goal(400, feedback)
+    assert goal.accepted
+    wait_until(lambda: any(f.feedback.stage in ("optimizing", "selecting") for f in list(feedback)),
+               "feedback from the optimizer")
+    lab.wait(goal.cancel_goal_async(), "the cancel response")
+    outcome = lab.wait(goal.get_result_async(), "the canceled result")
+    assert outcome.status == 5, outcome  # GoalStatus.STATUS_CANCELED
+    assert not outcome.result.proposals and "canceled" in outcome.result.error
+    status = lab.status()
+    assert (status.n_pending, status.state) == (0, "idle")
+    after = lab.recommend_now(1)  # the node goes on serving
+    assert after.status == 4 and len(after.result.proposals) == 1
+
+
+def test_parameters_are_validated_when_set_and_read_only_ones_refuse(lab, start_planner):
+    start_planner(auto_propose=False)
+    ok, reason = lab.set("batch_size", 0)
+    assert not ok and "at least 1" in reason
+    ok, reason = lab.set("acquisition_optimizer", "simplex")
+    assert not ok and "'adam', 'genetic' or empty" in reason
+    ok, _ = lab.set("storage", "/tmp/elsewhere.sqlite")
+    assert not ok  # read-only
+    ok, _ = lab.set("batch_size", "three")
+    assert not ok  # wrong type
+    assert lab.set("batch_size", 2) == (True, "")
+    assert lab.set("acquisition_optimizer", "genetic") == (True, "")
+    assert len(lab.recommend_now(0).result.proposals) == 2  # count 0: the node's batch_size, as set
+
+
+def test_the_params_file_example_configures_the_node(lab, start_planner, tmp_path):
+    example = EXAMPLES / "planner_params.yaml"
+    start_planner(wait=True, ros_args=("--params-file", str(example)), storage=str(tmp_path / "p.sqlite"))
+    answer = lab.call(lab.get_parameters, GetParameters.Request(names=["batch_size", "max_message_bytes"]))
+    assert [v.integer_value for v in answer.values] == [2, 65536]
+
+
+def test_a_failed_configure_leaves_the_node_unconfigured_and_says_why(lab, start_planner, tmp_path):
+    config = dict(FLOW_CONFIG, parameters=[{"name": "T", "type": "continuous", "low": 150.0, "high": 100.0}],
+                  constraints=[])
+    start_planner(config, autostart=False)
+    assert not lab.transition(Transition.TRANSITION_CONFIGURE)
+    assert lab.state() == "unconfigured"
+    diagnosis = wait_until(lambda: next((d.status[0] for d in list(lab.diagnostics)
+                                         if d.status[0].message.startswith("configure failed")), None),
+                           "diagnostics naming the failure")
+    assert diagnosis.level == DiagnosticStatus.ERROR and "'T'" in diagnosis.message
+
+
+def stored_ids(path: Path) -> tuple[set[str], set[str], int]:
+    with sqlite3.connect(path) as db:
+        observed = {r[0] for r in db.execute("SELECT experiment_id FROM observations")}
+        proposed = {r[0] for r in db.execute("SELECT experiment_id FROM proposals")}
+        rejected = db.execute("SELECT COUNT(*) FROM rejections").fetchone()[0]
+    return observed, proposed, rejected
+
+
+def test_two_campaigns_in_two_namespaces_do_not_cross(start_planner, tmp_path):
+    stores, emulators = {}, []
+    try:
+        for ns, seed in (("/lab1", 1), ("/lab2", 2)):
+            stores[ns] = tmp_path / f"{ns.strip('/')}.sqlite"
+            start_planner(ros_args=("-r", f"__ns:={ns}"), storage=str(stores[ns]), seed=seed)
+            emulators.append(subprocess.Popen(
+                [sys.executable, "-m", "gryffin_ros.nodes.emulator_node", "flow_reactor", "--ros-args", "-r",
+                 f"__ns:={ns}", "-p", f"seed:={seed}", "-p", "objectives:=[X1_X2]"],
+                env=node_env(tmp_path), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        wait_until(lambda: all(len(stored_ids(s)[0]) >= 4 for s in stores.values()), "4 experiments in each lab")
+    finally:
+        for emulator in emulators:
+            emulator.kill()
+            emulator.wait()
+    (observed1, proposed1, rejected1), (observed2, proposed2, rejected2) = (stored_ids(s) for s in stores.values())
+    assert observed1 <= proposed1 and observed2 <= proposed2
+    assert not proposed1 & proposed2
+    assert rejected1 == rejected2 == 0  # no observation of the other lab ever reached a planner
