@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
+import yaml
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from gryffin_ros_msgs.action import Recommend
 from gryffin_ros_msgs.msg import Event, ObjectiveValue, Observation, ParameterValue
@@ -289,3 +290,56 @@ def test_two_campaigns_in_two_namespaces_do_not_cross(start_planner, tmp_path):
     assert observed1 <= proposed1 and observed2 <= proposed2
     assert not proposed1 & proposed2
     assert rejected1 == rejected2 == 0  # no observation of the other lab ever reached a planner
+
+
+def readme_client() -> str:
+    """The typed lab client of the README's ROS section, as written."""
+    text = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    section = text[text.index("## From ROS 2"):]
+    start = section.index("```python\n") + len("```python\n")
+    return section[start:section.index("```", start)]
+
+
+def test_the_readme_typed_client_runs_as_written(start_planner, tmp_path):
+    config = yaml.safe_load((EXAMPLES / "flow_reactor.yaml").read_text())
+    store = tmp_path / "readme.sqlite"
+    start_planner(config, storage=str(store), auto_propose=False)
+    script = tmp_path / "lab.py"
+    instrument = ("def run_my_experiment(F_C, F_S, T):\n"
+                  "    return None if T > 149 else {'X1_X2': F_S / (F_C + F_S), 'cost': 0.001 * F_C}\n")
+    script.write_text(instrument + readme_client() + "rclpy.spin(node)\n")
+    client = subprocess.Popen([sys.executable, str(script)], env=node_env(tmp_path), stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, text=True)
+    try:
+        wait_until(lambda: client.poll() is not None or len(stored_ids(store)[0]) == 2, "the README client's results")
+    finally:
+        client.kill()
+        output = client.communicate()[0]
+    assert len(stored_ids(store)[0]) == 2, output
+    assert "optimizing" in output or "models" in output  # the feedback stages it prints
+
+
+def test_after_a_restart_a_client_that_retries_gets_the_experiment_still_owed(lab, start_planner, tmp_path):
+    """A killed node's services and action still look available to DDS for a while, so a request can go to the dead
+    node; the documented client rule: probe ~/get_status with a timeout, retry until it answers, then send goals."""
+    store = tmp_path / "restart.sqlite"
+    planner = start_planner(storage=str(store), auto_propose=False)
+    (owed,) = lab.recommend_now(1).result.proposals
+    planner.process.kill()
+    planner.process.wait()
+    start_planner(storage=str(store), auto_propose=False, wait=False)
+    attempts = 0
+    while True:
+        attempts += 1
+        assert attempts < 200, "the restarted planner never answered"
+        if not lab.get_status.wait_for_service(timeout_sec=1.0):
+            continue
+        future = lab.get_status.call_async(GetStatus.Request())
+        deadline = time.monotonic() + 2.0
+        while not future.done() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        if future.done():
+            break
+        lab.get_status.remove_pending_request(future)
+    (again,) = lab.recommend_now(1).result.proposals
+    assert again.experiment_id == owed.experiment_id  # still owed, handed out first
