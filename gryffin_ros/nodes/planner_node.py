@@ -107,7 +107,8 @@ class PlannerNode(LifecycleNode):
         self.configure_error: str | None = None
         self._rejections: deque[tuple[float, str]] = deque(maxlen=100)
         self._guard = None  # wakes auto-propose
-        self._inputs: list = []  # (destroy, entity) of the active state: subscriptions, services, action, timer
+        self._action: ActionServer | None = None
+        self._inputs: list = []  # (destroy, entity) of the active state: subscriptions, services, timer, guard
         self._outputs: dict[str, Any] = {}
         self.add_on_set_parameters_callback(self._on_set_parameters)
         # always there, in every state: a lifecycle manager and an operator see why a node is not running
@@ -141,6 +142,11 @@ class PlannerNode(LifecycleNode):
         self.campaign, self.storage = campaign, storage
         for text in campaign.warnings:
             self.get_logger().warning(text)
+        # the action lives until cleanup (goals are refused while inactive): a result in flight when the node is
+        # deactivated still reaches its client
+        self._action = ActionServer(self, Recommend, "~/recommend", execute_callback=self._execute_recommend,
+                                    goal_callback=self._on_goal, cancel_callback=lambda _goal: CancelResponse.ACCEPT,
+                                    callback_group=ReentrantCallbackGroup())
         self._outputs = {
             "proposals": self.create_lifecycle_publisher(typed.Proposals, "~/proposals", LATCHED_QOS),
             "events": self.create_lifecycle_publisher(typed.Event, "~/events", EVENTS_QOS),
@@ -170,7 +176,7 @@ class PlannerNode(LifecycleNode):
         result = super().on_activate(state)  # enables the lifecycle publishers
         campaign = self.campaign
         optimizer_group, observations_group = MutuallyExclusiveCallbackGroup(), MutuallyExclusiveCallbackGroup()
-        status_group, action_group = ReentrantCallbackGroup(), ReentrantCallbackGroup()
+        status_group = ReentrantCallbackGroup()
         # observations one at a time, in arrival order (so events and the store keep that order)
         self._guard = self.create_guard_condition(self._auto_propose, callback_group=optimizer_group)
         self._inputs = [
@@ -186,9 +192,6 @@ class PlannerNode(LifecycleNode):
                                                        qos_profile=SERVICES_QOS, callback_group=status_group)),
             (self.destroy_service, self.create_service(Trigger, "~/json/recommend", self._on_json_recommend,
                                                        qos_profile=SERVICES_QOS, callback_group=optimizer_group)),
-            (ActionServer.destroy, ActionServer(
-                self, Recommend, "~/recommend", execute_callback=self._execute_recommend, goal_callback=self._on_goal,
-                cancel_callback=lambda _goal: CancelResponse.ACCEPT, callback_group=action_group)),
             # experiments still owed after a quiet spell are announced again (a report may have been lost)
             (self.destroy_timer, self.create_timer(REMIND_AFTER_S / 2, self._remind, callback_group=status_group)),
             # auto-propose runs when woken (activation, an accepted observation) instead of polling with a timer
@@ -240,6 +243,9 @@ class PlannerNode(LifecycleNode):
         for publisher in self._outputs.values():
             self.destroy_lifecycle_publisher(publisher)
         self._outputs = {}
+        if self._action is not None:
+            self._action.destroy()
+            self._action = None
         if self.dashboard is not None:
             self.dashboard.close()
             self.dashboard = None

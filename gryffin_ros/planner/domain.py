@@ -60,6 +60,6 @@ def objective_value(name: str, value: Any) -> float | None:
         raise ObservationError(f"objective '{name}' must be a number or null, got {value!r}")
     value = float(value)
     if not math.isfinite(value):
-        raise ObservationError(f"objective '{name}' = {value} is not a result; report a failed experiment as None "
-                               "(JSON null, failed = true in a typed observation)")
+        raise ObservationError(f"objective '{name}' = {value} is not finite, not a result; report a failed experiment "
+                               "as None (JSON null, failed = true in a typed observation)")
     return value

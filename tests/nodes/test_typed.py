@@ -228,6 +228,18 @@ def test_a_long_recommendation_is_canceled_and_leaves_nothing_pending(lab, start
     after = lab.recommend_now(1)  # the node goes on serving
     assert after.status == 4 and len(after.result.proposals) == 1
 
+    # a deactivation stops a running recommendation too (aborted, nothing stored), and activation resumes serving
+    feedback.clear()
+    goal = lab.send_goal(400, feedback)
+    wait_until(lambda: any(f.feedback.stage in ("optimizing", "selecting") for f in list(feedback)),
+               "feedback from the optimizer")
+    assert lab.transition(Transition.TRANSITION_DEACTIVATE)
+    outcome = lab.wait(goal.get_result_async(), "the aborted result")
+    assert outcome.status == 6 and "deactivated" in outcome.result.error, outcome  # GoalStatus.STATUS_ABORTED
+    assert lab.transition(Transition.TRANSITION_ACTIVATE)
+    assert lab.status().n_pending == 1  # the one of `after`, still owed
+    assert lab.recommend_now(1).status == 4
+
 
 def test_parameters_are_validated_when_set_and_read_only_ones_refuse(lab, start_planner):
     start_planner(auto_propose=False)
