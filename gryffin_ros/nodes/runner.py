@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import Any
 
 import rclpy
+import yaml
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.exceptions import InvalidParameterTypeException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
@@ -50,6 +51,23 @@ def declare(node: Node, parameters: dict[str, tuple[Any, str]], read_only: tuple
     return values
 
 
+def unreadable_parameter(args: list[str]) -> str | None:
+    """Why a `-p name:=value` of these arguments would stop rcl's argument parser (which reads each value as YAML and
+    says only "Unknown YAML event" for one it cannot take, such as `:memory:`, a mapping to YAML), or None."""
+    for flag, argument in zip(args, args[1:]):
+        if flag not in ("-p", "--param") or ":=" not in argument:
+            continue
+        name, value = argument.split(":=", 1)
+        try:
+            parsed = yaml.safe_load(value)
+        except yaml.YAMLError:
+            parsed = {}
+        if isinstance(parsed, dict):
+            return (f"parameter '{name}': ROS reads the value {value!r} as YAML and cannot take it; quote it: "
+                    f"-p \"{name}:='{value}'\"")
+    return None
+
+
 def environment_line() -> str:
     """What a lab client must match to see this node: domain, RMW, discovery range."""
     return (f"ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID', '0 (unset)')}, "
@@ -61,6 +79,10 @@ def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None
         executor: Callable[[], Executor] = SingleThreadedExecutor,
         on_exit: Callable[[Node], None] | None = None) -> int:
     apply_to_this_process()
+    unreadable = unreadable_parameter(sys.argv[1:] if args is None else args)
+    if unreadable:
+        print(f"{label}: cannot start: {unreadable}", file=sys.stderr)
+        return 2
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     stop = threading.Event()
 

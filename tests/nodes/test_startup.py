@@ -54,3 +54,13 @@ def test_a_parameter_of_the_wrong_type_is_named_with_what_it_takes(tmp_path):
     result = start(tmp_path, FLOW_CONFIG, ["batch_size:=three"])
     assert result.returncode == 2, result.stderr
     assert "parameter 'batch_size' must be an integer" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_a_parameter_value_ros_cannot_parse_is_named_with_how_to_quote_it(tmp_path):
+    path = tmp_path / "config.json"
+    path.write_text(json.dumps(FLOW_CONFIG))
+    result = subprocess.run([sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-p",
+                             f"config:={path}", "-p", "storage:=:memory:"], env=node_env(tmp_path),
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2, result.stderr
+    assert "parameter 'storage'" in result.stderr and "quote it" in result.stderr, result.stderr
