@@ -241,17 +241,17 @@ class Campaign:
             self._absorb()
 
     # ---- proposals -----------------------------------------------------------------------------------------
-    def propose(self, n: int | None = None, claimed: bool = True, started: Callable[[], None] | None = None,
+    def propose(self, n: int | None = None, claimed: bool = True,
                 progress: ProgressCallback | None = None) -> list[Proposal]:
         """`n` new proposals (default general.batches), stored before they are returned. `claimed=False` marks
         them as published without being asked for (auto-propose), so that `claim` hands them out later.
-        `started` is called once the optimization has begun (status is then "optimizing"). `progress(stage,
-        fraction, ready)` is called at checkpoints (stage "waiting" while another proposal runs) and may stop the
-        proposal by raising `Cancelled`: nothing is then stored or pending, and the planner is as before."""
+        `progress(stage, fraction, ready)` is called at checkpoints of the optimization (the status says
+        "optimizing" then; stage "waiting" while another proposal holds the planner) and may stop the proposal by
+        raising `Cancelled`: nothing is then stored or pending, and the planner is as before."""
         self._acquire_planner(progress)
         try:
             with reporting(progress):
-                return self._propose(n, claimed, started)
+                return self._propose(n, claimed)
         finally:
             self._planner_lock.release()
 
@@ -262,7 +262,7 @@ class Campaign:
         while not self._planner_lock.acquire(timeout=WAIT_REPORT_S):
             progress("waiting", 0.0, 0)  # may raise Cancelled: nothing was held
 
-    def _propose(self, n: int | None, claimed: bool, started: Callable[[], None] | None) -> list[Proposal]:
+    def _propose(self, n: int | None, claimed: bool) -> list[Proposal]:
         with self._state_lock:
             if self._closed:
                 raise CampaignClosed(f"campaign '{self.name}' is closed; nothing is proposed")
@@ -270,8 +270,6 @@ class Campaign:
         counters = (self.planner.ask_count, self.planner.proposal_count)
         proposals: list[Proposal] = []
         try:
-            if started is not None:
-                started()
             self._absorb()
             proposals = self.planner.ask(n)
             self.store.add_proposals(proposals, {"ask_count": str(self.planner.ask_count),
@@ -290,17 +288,16 @@ class Campaign:
         self._absorb()  # what arrived while optimizing
         return proposals
 
-    def claim(self, n: int | None = None, started: Callable[[], None] | None = None,
-              progress: ProgressCallback | None = None) -> list[Proposal]:
+    def claim(self, n: int | None = None, progress: ProgressCallback | None = None) -> list[Proposal]:
         """`n` proposals for someone who asks (the node's recommend): unclaimed pending ones first, each handed out
-        once, then new ones (`started` and `progress` as in `propose`)."""
+        once, then new ones (`progress` as in `propose`)."""
         n = self.config.general.batches if n is None else n
         with self._state_lock:
             taken, self._unclaimed = self._unclaimed[:n], self._unclaimed[n:]
             handed = [self._pending[i] for i in taken]
         if len(handed) < n:
             try:
-                handed += self.propose(n - len(handed), started=started, progress=progress)
+                handed += self.propose(n - len(handed), progress=progress)
             except BaseException:
                 with self._state_lock:  # nothing was handed out: the unclaimed stay unclaimed
                     self._unclaimed[:0] = [i for i in taken if i in self._pending]

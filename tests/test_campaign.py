@@ -191,8 +191,8 @@ def test_a_closed_campaign_stores_nothing_more(tmp_path):
 def test_status_says_optimizing_while_proposing_and_a_failed_claim_keeps_the_unclaimed(tmp_path, monkeypatch):
     campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
     seen = []
-    published = campaign.propose(1, claimed=False, started=lambda: seen.append(campaign.status()["state"]))
-    assert seen == ["optimizing"] and campaign.status()["state"] == "idle"
+    published = campaign.propose(1, claimed=False, progress=lambda *_: seen.append(campaign.status()["state"]))
+    assert seen and set(seen) == {"optimizing"} and campaign.status()["state"] == "idle"
 
     def broken(n=None):
         raise RuntimeError("optimizer crashed")
@@ -221,3 +221,27 @@ def test_proposals_the_store_could_not_take_are_forgotten_and_drawn_again(tmp_pa
     campaign.close()
     with pytest.raises(CampaignClosed):
         campaign.propose(1)
+
+
+def test_a_proposal_stopped_at_a_checkpoint_leaves_nothing_behind_and_the_next_draws_the_same(tmp_path):
+    from gryffin_ros.planner.reporting import Cancelled
+
+    def campaign_with_data(path):
+        campaign = Campaign(CONFIG, path, seed=0)
+        for i, proposal in enumerate(campaign.propose(3)):
+            campaign.observe(report(proposal, float(i)))
+        return campaign
+    stopped, plain = campaign_with_data(tmp_path / "a.sqlite"), campaign_with_data(tmp_path / "b.sqlite")
+    stages = []
+
+    def stop_when_optimizing(stage, fraction, ready):
+        stages.append(stage)
+        assert 0.0 <= fraction <= 1.0
+        if stage == "optimizing":
+            raise Cancelled("stopped by the test")
+    with pytest.raises(Cancelled):
+        stopped.claim(2, progress=stop_when_optimizing)
+    assert stages[0] == "models" and stages[-1] == "optimizing"
+    assert stopped.pending == [] and stopped.status()["state"] == "idle"
+    again, reference = stopped.propose(2), plain.propose(2)
+    assert [p.params for p in again] == [p.params for p in reference]
