@@ -1,5 +1,6 @@
 """The process environment every rclpy process of this project runs with: DDS discovery on loopback only, the
-fast-discovery Fast DDS profile, and a ROS domain of its own when the caller has not chosen one."""
+fast-discovery Fast DDS profile; processes this project starts (tests, campaigns, benchmarks) get a ROS domain of their
+own when the caller has not chosen one, a node started by hand keeps ROS's default."""
 
 from __future__ import annotations
 
@@ -25,5 +26,9 @@ def ros_environment(base: Mapping[str, str] | None = None, domain_id: int | None
 
 
 def apply_to_this_process() -> None:
-    """Set the loopback-only environment in this process before rclpy initializes."""
-    os.environ.update(ros_environment())
+    """Set the loopback-only environment in this process before rclpy initializes. The domain stays the caller's
+    (ROS's default 0 when unset): a node started by hand must be found by lab clients that export nothing."""
+    env = ros_environment()
+    if "ROS_DOMAIN_ID" not in os.environ:
+        del env["ROS_DOMAIN_ID"]
+    os.environ.update(env)

@@ -119,7 +119,7 @@ class PlannerNode(LifecycleNode):
     def lifecycle_state(self) -> str:
         return self._state_machine.current_state[1]
 
-    def configure_or_raise(self) -> None:
+    def _open_campaign(self) -> None:
         """Open the campaign (configure's work); raises StartupError (or another GryffinRosError) saying why not."""
         for name in PARAMETERS:
             reason = check_parameter(name, self.p[name])
@@ -162,7 +162,7 @@ class PlannerNode(LifecycleNode):
 
     def on_configure(self, state) -> TransitionCallbackReturn:
         try:
-            self.configure_or_raise()
+            self._open_campaign()
         except Exception as exc:  # noqa: BLE001 - whatever it is, the node stays up, unconfigured, and says why
             reason = str(exc) if isinstance(exc, GryffinRosError) else f"internal error: {exc!r}"
             self.configure_error = reason

@@ -70,7 +70,7 @@ def unreadable_parameter(args: list[str]) -> str | None:
 
 def environment_line() -> str:
     """What a lab client must match to see this node: domain, RMW, discovery range."""
-    return (f"ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID', '0 (unset)')}, "
+    return (f"ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID', '0 (unset: the ROS default)')}, "
             f"RMW_IMPLEMENTATION={os.environ.get('RMW_IMPLEMENTATION', 'default')}, "
             f"ROS_AUTOMATIC_DISCOVERY_RANGE={os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE', 'default')}")
 
