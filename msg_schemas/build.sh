@@ -14,7 +14,8 @@ command -v cmake >/dev/null || missing+=("cmake (Debian: apt-get install cmake)"
 command -v c++ >/dev/null || command -v g++ >/dev/null || missing+=("a C++ compiler (Debian: apt-get install g++)")
 command -v cc >/dev/null || command -v gcc >/dev/null || missing+=("a C compiler (Debian: apt-get install gcc)")
 if [ ${#missing[@]} -gt 0 ]; then
-  echo "gryffin_ros_msgs cannot be built: missing ${missing[*]}." >&2
+  joined="$(printf '%s; ' "${missing[@]}")"
+  echo "gryffin_ros_msgs cannot be built: missing ${joined%; }." >&2
   echo "The planner node's typed interfaces need it; install what is missing and run make again." >&2
   exit 2
 fi
