@@ -173,7 +173,7 @@ class Planner(BasePlanner):
         feasibility = self._feasibility(self.observed_points(), generator)
         if not successful:
             return Surrogates(successful, np.empty((0, self.space.dim)), np.empty(0), {}, None, feasibility)
-        X = self._internal([o.params for o in successful])
+        X = self.observed_points()[np.array([not o.failed for o in self.observations], dtype=bool)]
         merits = self.merits(successful)
         descriptors = {d: r.table for d, r in self.learned_descriptors(X, merits).items()}
         density = KernelDensity(self.space, X, merits, self.feasible_fraction.value, generator,

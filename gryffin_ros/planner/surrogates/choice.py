@@ -46,11 +46,12 @@ class SurrogateChoice:
 
     def gaussian_process(self, X: np.ndarray, successful: Sequence[Observation],
                          descriptors: Mapping[int, np.ndarray]) -> GaussianProcess:
-        """The GP of the untransformed merits, conditioned on every successful experiment, with hyperparameters
-        fitted to the first `fit_size(n)` of them (at most FIT_MAX of those, `fit_subset`; cached; learned descriptors
-        change with every observation, so with them every ask fits). Fits are seeded by the campaign seed and their
-        size alone, so they never change the draws of the rest of the ask."""
-        from .gaussian_process import FIT_MAX, GaussianProcess, fit_size, fit_subset
+        """The GP of the untransformed merits, conditioned on every successful experiment (at most COND_MAX of them,
+        `condition_subset`), with hyperparameters fitted to the first `fit_size(n)` of them (at most FIT_MAX of those,
+        `fit_subset`; cached; learned descriptors change with every observation, so with them every ask fits). Fits
+        and subsets are seeded by the campaign seed and their size alone, so they never change the draws of the rest
+        of the ask."""
+        from .gaussian_process import FIT_MAX, GaussianProcess, condition_subset, fit_size, fit_subset
 
         def seed(size: int) -> int:
             return int(np.random.default_rng([self.seed, size, 3]).integers(2**62))
@@ -62,7 +63,10 @@ class SurrogateChoice:
             subset = fit_subset(y[:size], seed(size))
             hyperparameters = GaussianProcess(self.space, X[subset], y[subset], seed(size), descriptors
                                               ).hyperparameters
-        gp = GaussianProcess(self.space, X, y, seed(size), descriptors, hyperparameters)
+        # above COND_MAX observations, conditioned on a subset (there size > FIT_MAX: hyperparameters are given)
+        kept = condition_subset(y, int(np.random.default_rng([self.seed, len(X), 4]).integers(2**62)))
+        gp = GaussianProcess(self.space, X[kept], y[kept], seed(size), descriptors, hyperparameters)
+        gp.conditioned = kept
         if not descriptors:
             self._gp_fit = (size, gp.hyperparameters)
         return gp
@@ -97,10 +101,16 @@ class SurrogateChoice:
                         "distinct successful results to compare the models on"}
         from .gaussian_process import rank_correlation
         gp = self.gaussian_process(X, successful, descriptors)
-        scores = {"kde": round(rank_correlation(density.leave_one_out(), merits), 4),
-                  "gp": round(rank_correlation(gp.leave_one_out(), merits), 4)}
+        kept = gp.conditioned  # both models are scored on the observations the GP is conditioned on
+        if len(np.unique(merits[kept])) < AUTO_MIN_OBSERVATIONS:
+            return (gp if prior == "gp" else None), {
+                "surrogate": prior, "surrogate_reason": f"{shape}; fewer than {AUTO_MIN_OBSERVATIONS} distinct "
+                "successful results among those the GP is conditioned on to compare the models on"}
+        scores = {"kde": round(rank_correlation(density.leave_one_out(kept), merits[kept]), 4),
+                  "gp": round(rank_correlation(gp.leave_one_out(), merits[kept]), 4)}
         z = {name: math.atanh(min(max(r, -0.999), 0.999)) for name, r in scores.items()}
         other = "kde" if prior == "gp" else "gp"
+        levels = len(np.unique(merits[kept]))
         margin = math.sqrt(1.06 / (levels - 3))
         chosen = other if z[other] - z[prior] > margin else prior
         verdict = ("clearly better" if chosen == other else "not clearly better")

@@ -141,11 +141,11 @@ class KernelDensity:
         weights = torch.softmax(self.log_kernels(xc, xf), dim=1)
         return weights @ self.merits
 
-    def leave_one_out(self) -> np.ndarray:
-        """(n,) kernel regression at each observation from the kernels of all other observations (its mirrored
-        copies left out too)."""
-        n = len(self.observed)
+    def leave_one_out(self, at: np.ndarray | None = None) -> np.ndarray:
+        """Kernel regression at each observation (or at the observations of indices `at`) from the kernels of all
+        other observations (its mirrored copies left out too): (n,) or (len(at),)."""
+        at = np.arange(len(self.observed)) if at is None else np.asarray(at)
         with torch.no_grad():
-            log_p = self.log_kernels(*split(self.space, self.observed))
-            log_p[torch.as_tensor(self.origin)[None, :] == torch.arange(n)[:, None]] = -math.inf
+            log_p = self.log_kernels(*split(self.space, self.observed[at]))
+            log_p[torch.as_tensor(self.origin)[None, :] == torch.as_tensor(at)[:, None]] = -math.inf
             return (torch.softmax(log_p, dim=1) @ self.merits).numpy()

@@ -194,11 +194,11 @@ def test_portfolio_leaves_its_first_model_only_on_clear_evidence(monkeypatch):
     planner = Planner(config3(), seed=1)
     run(planner, 12, bowl3)
     merits = planner.merits([o for o in planner.observations if not o.failed])
-    monkeypatch.setattr(KernelDensity, "leave_one_out", lambda self: np.asarray(merits))
+    monkeypatch.setattr(KernelDensity, "leave_one_out", lambda self, at=None: np.asarray(merits))
     meta = planner.ask()[0].meta
     assert meta["surrogate"] == "kde" and meta["loo_rank_correlation"]["kde"] == 1.0
     assert "kernel density clearly better" in meta["surrogate_reason"]
-    monkeypatch.setattr(KernelDensity, "leave_one_out", lambda self: -np.asarray(merits))
+    monkeypatch.setattr(KernelDensity, "leave_one_out", lambda self, at=None: -np.asarray(merits))
     meta = planner.ask()[0].meta
     assert meta["surrogate"] == "gp" and "kernel density not clearly better" in meta["surrogate_reason"]
 
