@@ -30,8 +30,10 @@ from gryffin_ros.rosenv import ros_environment
 os.environ.update(ros_environment())
 
 import rclpy  # noqa: E402
+from gryffin_ros_msgs.action import Recommend  # noqa: E402
 from gryffin_ros_msgs.msg import Event, Observation  # noqa: E402
 from gryffin_ros_msgs.srv import GetStatus  # noqa: E402
+from rclpy.action import ActionClient  # noqa: E402
 from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 
 from gryffin_ros.campaign import Campaign  # noqa: E402
@@ -84,6 +86,7 @@ class Watcher:
                                       OBSERVATIONS_SUBSCRIPTION_QOS)
         self.node.create_subscription(Event, "/gryffin_planner/events", self._on_event, EVENTS_QOS)
         self.status = self.node.create_client(GetStatus, "/gryffin_planner/get_status")
+        self.recommend = ActionClient(self.node, Recommend, "/gryffin_planner/recommend")
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         threading.Thread(target=self.executor.spin, daemon=True).start()
@@ -122,6 +125,29 @@ class Watcher:
                     return time.perf_counter() - started
                 self.status.remove_pending_request(future)
         raise TimeoutError("the restarted planner never answered")
+
+    def single_asks(self, count: int) -> list[float]:
+        """Seconds of `count` one-proposal Recommend goals, one after the other (goal sent -> result)."""
+        def wait(future):
+            deadline = time.monotonic() + 300
+            while not future.done():
+                if time.monotonic() > deadline:
+                    raise TimeoutError("no answer to a Recommend goal")
+                time.sleep(0.005)
+            return future.result()
+        if not self.recommend.wait_for_server(timeout_sec=60):
+            raise TimeoutError("no Recommend action server")
+        # the experiments still owed after the restart are handed out first, without an ask: take them first
+        owed = wait(self.status.call_async(GetStatus.Request())).status.n_pending
+        if owed:
+            wait(wait(self.recommend.send_goal_async(Recommend.Goal(count=owed))).get_result_async())
+        out = []
+        for _ in range(count):
+            start = time.perf_counter()
+            goal = wait(self.recommend.send_goal_async(Recommend.Goal(count=1)))
+            wait(goal.get_result_async())
+            out.append(time.perf_counter() - start)
+        return out
 
     def close(self) -> None:
         self.executor.shutdown()
@@ -170,6 +196,7 @@ def over_ros(args: argparse.Namespace, work: Path, config) -> tuple[list[dict], 
         planner = subprocess.Popen(planner_cmd + ["-p", "auto_propose:=false"], env=env, stdout=subprocess.DEVNULL,
                                    stderr=subprocess.DEVNULL)
         restart = watcher.ready_after(restart_started, args.budget)
+        single = watcher.single_asks(5)
     finally:
         watcher.close()
         for process in (planner, emulator):
@@ -180,7 +207,7 @@ def over_ros(args: argparse.Namespace, work: Path, config) -> tuple[list[dict], 
     subprocess.run([sys.executable, "-m", "gryffin_ros.cli", "export", str(store), "--csv", str(work / "soak.csv")],
                    check=True, capture_output=True)
     export = time.perf_counter() - export_started
-    return rows, {"restart_s": restart, "export_s": export, "best_cost": best}
+    return rows, {"restart_s": restart, "export_s": export, "best_cost": best, "single_ask_s": single}
 
 
 def in_process(args: argparse.Namespace, work: Path) -> list[dict]:
@@ -260,7 +287,9 @@ def main() -> None:
                                ("store_mb", "store MB"), ("elapsed_s", "elapsed s")])
             + f"\nRestart of the planner node on the full store, process start to a status answer: "
               f"{end['restart_s']:.1f} s; `gryffin-ros export STORE --csv` (process start included): "
-              f"{end['export_s']:.1f} s. Best cost (X1 + X2 >= 0.9 first) after "
+              f"{end['export_s']:.1f} s. Then five one-proposal `Recommend` goals on the {args.budget} "
+              f"observations (goal sent -> result): median {statistics.median(end['single_ask_s']):.2f} s, max "
+              f"{max(end['single_ask_s']):.2f} s. Best cost (X1 + X2 >= 0.9 first) after "
             + ", ".join(f"{k}: {'-' if v is None else f'{v:.5f}'}" for k, v in end["best_cost"].items()) + ".\n")
     if api_rows:
         text += ("\nThrough the Python API (`Campaign` in one process, same settings):\n\n"
