@@ -102,7 +102,8 @@ class SurrogateChoice:
         from .gaussian_process import rank_correlation
         gp = self.gaussian_process(X, successful, descriptors)
         kept = gp.conditioned  # both models are scored on the observations the GP is conditioned on
-        if len(np.unique(merits[kept])) < AUTO_MIN_OBSERVATIONS:
+        levels = len(np.unique(merits[kept]))
+        if levels < AUTO_MIN_OBSERVATIONS:
             return (gp if prior == "gp" else None), {
                 "surrogate": prior, "surrogate_reason": f"{shape}; fewer than {AUTO_MIN_OBSERVATIONS} distinct "
                 "successful results among those the GP is conditioned on to compare the models on"}
@@ -110,7 +111,6 @@ class SurrogateChoice:
                   "gp": round(rank_correlation(gp.leave_one_out(), merits[kept]), 4)}
         z = {name: math.atanh(min(max(r, -0.999), 0.999)) for name, r in scores.items()}
         other = "kde" if prior == "gp" else "gp"
-        levels = len(np.unique(merits[kept]))
         margin = math.sqrt(1.06 / (levels - 3))
         chosen = other if z[other] - z[prior] > margin else prior
         verdict = ("clearly better" if chosen == other else "not clearly better")

@@ -32,7 +32,7 @@ OUTPUTSCALE_BOUNDS = (1e-3, 100.0)
 CHUNK = 4096
 # Hyperparameters are fitted to at most FIT_MAX observations (each marginal-likelihood evaluation costs n^3: a fit took
 # 7 s at n = 1000, d = 10): the best FIT_BEST of them by merit, where the acquisition works, and an even random draw
-# of the rest. The GP is then conditioned on every observation with those hyperparameters.
+# of the rest. The GP is then conditioned with those hyperparameters on every observation, up to COND_MAX.
 FIT_MAX, FIT_BEST = 300, 100
 # Above COND_MAX observations the GP is conditioned on COND_MAX of them: the COND_BEST best by merit (the incumbent
 # and where the acquisition works) and a seeded random draw of the rest, new each ask. Exact conditioning costs n^3

@@ -327,3 +327,21 @@ def test_a_gp_batch_keeps_its_points_apart():
     d = np.sqrt(((X[:, None] - X[None]) ** 2).sum(-1))[np.triu_indices(12, 1)]
     assert d.min() >= batch_spacing(planner.space, 12, planner.feasible_fraction.value) - 1e-12
     assert batch_spacing(planner.space, 12, 1.0) == pytest.approx(0.25 * 12 ** (-1 / 3))
+
+
+def test_above_cond_max_the_gp_is_conditioned_on_the_best_and_a_draw_and_both_models_are_scored_there(monkeypatch):
+    """Past COND_MAX observations the GP is conditioned on COND_MAX of them, always including the COND_BEST best,
+    and the portfolio compares the two models on those same observations."""
+    monkeypatch.setattr(gp_module, "COND_MAX", 20)
+    monkeypatch.setattr(gp_module, "COND_BEST", 5)
+    planner = Planner(config3(), seed=2)
+    run(planner, 30, bowl3)
+    successful = [o for o in planner.observations if not o.failed]
+    X = planner.observed_points()
+    gp = planner.surrogate_choice.gaussian_process(X, successful, {})
+    merits = planner.surrogate_choice.raw_merits(successful)
+    assert len(gp.conditioned) == 20 and len(set(gp.conditioned.tolist())) == 20
+    assert set(np.argsort(merits, kind="stable")[:5].tolist()) <= set(gp.conditioned.tolist())
+    assert len(gp.leave_one_out()) == 20
+    proposal = planner.ask()[0]
+    assert set(proposal.meta["loo_rank_correlation"]) == {"kde", "gp"}
