@@ -13,6 +13,7 @@ import subprocess
 import sys
 import threading
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -126,17 +127,24 @@ def client(lab_session):
     return lab_session
 
 
+@contextmanager
+def spinning(node: Node):
+    """The node, spun by an executor of its own in a background thread until the block ends; then destroyed."""
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    threading.Thread(target=executor.spin, daemon=True).start()
+    try:
+        yield node
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+
+
 @pytest.fixture(scope="session")
 def lab_session():
     rclpy.init()
-    node = Client()
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    thread = threading.Thread(target=executor.spin, daemon=True)
-    thread.start()
-    yield node
-    executor.shutdown()
-    node.destroy_node()
+    with spinning(Client()) as node:
+        yield node
     rclpy.try_shutdown()
 
 

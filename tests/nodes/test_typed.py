@@ -24,14 +24,13 @@ from rcl_interfaces.msg import Parameter, ParameterType
 from rcl_interfaces.msg import ParameterValue as RosParameterValue
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rclpy.action import ActionClient
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import qos_profile_system_default
 
 from gryffin_ros.nodes.qos import EVENTS_QOS, OBSERVATIONS_QOS
 from gryffin_ros.paths import share_path
 
-from .conftest import FLOW_CONFIG, HANG_S, flow_feasible, node_env
+from .conftest import FLOW_CONFIG, HANG_S, flow_feasible, node_env, spinning
 
 EXAMPLES = share_path("examples")
 # a campaign whose recommendation of many points takes far longer than a cancel needs to arrive (the genetic
@@ -131,14 +130,8 @@ class TypedLab(Node):
 @pytest.fixture
 def lab(lab_session):
     """A typed lab client in this test process (rclpy is initialized by the session's JSON client)."""
-    node = TypedLab("typed_lab")
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    thread = threading.Thread(target=executor.spin, daemon=True)
-    thread.start()
-    yield node
-    executor.shutdown()
-    node.destroy_node()
+    with spinning(TypedLab("typed_lab")) as node:
+        yield node
 
 
 def observation_of(proposal, objectives: dict[str, float] | None, **changes) -> Observation:
