@@ -14,7 +14,9 @@ it; the node only translates messages. What it guarantees:
 Pending proposals follow one rule: a proposal stays pending until an observation reports it. Proposals published
 without being asked for (auto-propose) are *unclaimed*; `claim` (the node's recommend) hands out unclaimed pending
 proposals first, each once, and asks the planner only for the rest, so an auto-published batch is never left
-behind by a lab that asks for its experiments.
+behind by a lab that asks for its experiments. An instrument that claims under its name is handed back what it
+claimed and has not reported before anything else: asking again is safe when an answer was lost (a network cut),
+and no other instrument is given those experiments, also after a restart (claims are stored).
 """
 
 from __future__ import annotations
@@ -87,6 +89,7 @@ class Campaign:
         self._reported = {o.experiment_id for o in observations}
         self._pending: dict[str, Proposal] = dict(self.planner.pending)
         self._unclaimed: list[str] = []  # pending ids published but not yet handed to anyone asking
+        self._claims: dict[str, str] = self.store.claims()  # pending id -> the instrument it was handed to
         self._inbox: list[Observation] = []  # committed, not yet learnt by the planner
         self._n_failed = sum(o.failed for o in observations)
         self._best = self.planner.best()
@@ -194,6 +197,7 @@ class Campaign:
         with self._state_lock:
             self._inbox.append(observation)
             self._pending.pop(experiment_id, None)
+            self._claims.pop(experiment_id, None)
             self._n_failed += observation.failed
         if self._planner_lock.acquire(blocking=False):  # never wait for a running optimization here
             try:
@@ -288,26 +292,40 @@ class Campaign:
         self._absorb()  # what arrived while optimizing
         return proposals
 
-    def claim(self, n: int | None = None, progress: ProgressCallback | None = None) -> list[Proposal]:
+    def claim(self, n: int | None = None, progress: ProgressCallback | None = None,
+              instrument: str = "") -> list[Proposal]:
         """`n` proposals for someone who asks (the node's recommend): unclaimed pending ones first, each handed out
-        once, then new ones (`progress` as in `propose`)."""
+        once, then new ones (`progress` as in `propose`). An `instrument` (a name unique in the lab) is first
+        handed back the experiments it claimed before and has not reported, oldest first: asking again after a
+        lost answer returns the same experiments, and they are never handed to anyone else."""
         n = self.config.general.batches if n is None else n
         with self._state_lock:
-            taken, self._unclaimed = self._unclaimed[:n], self._unclaimed[n:]
-            handed = [self._pending[i] for i in taken]
+            owned = [i for i, owner in self._claims.items() if instrument and owner == instrument
+                     and i in self._pending][:n]
+            room = n - len(owned)
+            taken, self._unclaimed = self._unclaimed[:room], self._unclaimed[room:]
+            handed = [self._pending[i] for i in owned + taken]
+        made: list[Proposal] = []
         if len(handed) < n:
             try:
-                handed += self.propose(n - len(handed), progress=progress)
+                made = self.propose(n - len(handed), progress=progress)
             except BaseException:
                 with self._state_lock:  # nothing was handed out: the unclaimed stay unclaimed
                     self._unclaimed[:0] = [i for i in taken if i in self._pending]
                 raise
-        return handed
+        if instrument:
+            fresh = taken + [p.experiment_id for p in made]
+            if fresh:
+                self.store.add_claims(fresh, instrument)  # stored before anyone is told
+                with self._state_lock:
+                    self._claims.update((i, instrument) for i in fresh if i in self._pending)
+        return handed + made
 
     def mark_unclaimed(self) -> None:
-        """Every pending proposal becomes unclaimed again (after a restart they are announced to everyone)."""
+        """Every pending proposal not claimed by a named instrument becomes unclaimed again (after a restart they
+        are announced to everyone; an instrument's claims stay its own)."""
         with self._state_lock:
-            self._unclaimed = list(self._pending)
+            self._unclaimed = [i for i in self._pending if i not in self._claims]
 
     # ---- lifetime ------------------------------------------------------------------------------------------
     def close(self) -> None:

@@ -33,6 +33,8 @@ CREATE TABLE IF NOT EXISTS proposals (
 CREATE TABLE IF NOT EXISTS observations (
     seq INTEGER PRIMARY KEY AUTOINCREMENT, experiment_id TEXT NOT NULL UNIQUE, params TEXT NOT NULL,
     objectives TEXT NOT NULL, meta TEXT NOT NULL, raw TEXT, received REAL NOT NULL);
+CREATE TABLE IF NOT EXISTS claims (
+    experiment_id TEXT PRIMARY KEY, instrument TEXT NOT NULL, claimed REAL NOT NULL);
 CREATE TABLE IF NOT EXISTS rejections (
     seq INTEGER PRIMARY KEY AUTOINCREMENT, experiment_id TEXT, reason TEXT NOT NULL, raw TEXT, received REAL NOT NULL);
 """
@@ -238,6 +240,22 @@ class CampaignStore:
     def pending(self) -> list[Proposal]:
         """Proposals without an observation yet, oldest first."""
         return self._proposals("WHERE experiment_id NOT IN (SELECT experiment_id FROM observations)")
+
+    def add_claims(self, experiment_ids: Iterable[str], instrument: str) -> None:
+        """Record that these experiments were handed to `instrument` (kept across restarts)."""
+        now = time.time()
+        with self._transaction():
+            self._db.executemany("INSERT OR REPLACE INTO claims (experiment_id, instrument, claimed) VALUES (?, ?, ?)",
+                                 [(i, instrument, now) for i in experiment_ids])
+
+    def claims(self) -> dict[str, str]:
+        """Pending experiment id -> the instrument it was handed to (none in a store written before claims)."""
+        try:
+            rows = self._query("SELECT experiment_id, instrument FROM claims WHERE experiment_id NOT IN "
+                               "(SELECT experiment_id FROM observations) ORDER BY claimed, rowid")
+        except sqlite3.OperationalError:
+            return {}
+        return dict(rows)
 
     def raw(self, experiment_id: str) -> str | None:
         """The message an observation arrived in, as it arrived (None when it came through the Python API)."""

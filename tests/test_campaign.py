@@ -165,6 +165,28 @@ def test_auto_published_proposals_are_handed_out_first_by_claim(tmp_path):
     assert [p.experiment_id for p in campaign.claim(3)] == [p.experiment_id for p in campaign.pending]
 
 
+def test_an_instrument_asking_again_gets_its_unreported_claims_back_and_nobody_else_does(tmp_path):
+    path = tmp_path / "c.sqlite"
+    ids = lambda proposals: [p.experiment_id for p in proposals]  # noqa: E731
+    with Campaign(CONFIG, path, seed=0) as campaign:
+        published = campaign.propose(2, claimed=False)
+        a, b = campaign.claim(1, instrument="/lab/a"), campaign.claim(1, instrument="/lab/b")
+        assert ids(a + b) == ids(published)  # the published batch is shared between the two
+        assert campaign.claim(1, instrument="/lab/a") == a  # a lost answer: asked again, the same experiment
+        more = campaign.claim(2, instrument="/lab/a")  # its own first, then a new one
+        assert more[0] == a[0] and more[1].experiment_id not in ids(published)
+        campaign.observe(report(a[0]))
+        assert campaign.claim(1, instrument="/lab/a") == more[1:]
+        anonymous = campaign.claim(1)  # a caller without a name never gets an instrument's claims
+        assert anonymous[0].experiment_id not in ids(b + more)
+    with Campaign(CONFIG, path) as campaign:  # a restart: the claims are stored, what nobody named is unclaimed
+        campaign.mark_unclaimed()
+        assert campaign.claim(1, instrument="/lab/c") == anonymous
+        assert campaign.claim(1, instrument="/lab/b") == b
+        assert campaign.claim(1, instrument="/lab/a") == more[1:]
+        assert len(campaign.pending) == 3  # nothing was proposed for the three who asked again
+
+
 def test_status_follows_the_campaign_and_fits_the_schema(tmp_path):
     campaign = Campaign({**CONFIG, "constraints": [*CONFIG["constraints"], "x < 50"]}, tmp_path / "c.sqlite",
                         seed=0)

@@ -574,6 +574,7 @@ class PlannerNode(LifecycleNode):
 
     def _execute_recommend(self, goal_handle) -> Recommend.Result:
         count = goal_handle.request.count or self.p["batch_size"]
+        instrument = goal_handle.request.instrument
         started, last = time.monotonic(), [None, 0.0]
 
         def feedback(stage: str, fraction: float, ready: int) -> None:
@@ -587,7 +588,7 @@ class PlannerNode(LifecycleNode):
 
         result = Recommend.Result()
         try:
-            proposals = self._recommend(lambda progress: self.campaign.claim(count, progress=progress), feedback,
+            proposals = self._recommend(lambda progress: self.campaign.claim(count, progress, instrument), feedback,
                                         lambda: goal_handle.is_cancel_requested)
         except Cancelled as exc:
             result.error = str(exc)

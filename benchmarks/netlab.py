@@ -1,0 +1,177 @@
+"""Separate hosts on one machine: Linux network namespaces joined by a switch, for tests and benchmarks of a lab whose
+planner and instruments run on different computers.
+
+A `NetLab` creates one namespace per host and one for the switch: the switch holds a bridge, each host is joined to
+it by a veth pair (`eth0` inside the host, `<host>` on the bridge) with an address of a private subnet, and the hosts
+have their own loopback. Nothing is connected to the machine's own interfaces, so every packet — DDS discovery
+multicast included — stays inside namespaces the lab created. `cut(host)` takes a host's link down (on the switch's
+side, as a pulled cable: the host's `eth0` loses its carrier), `restore(host)` brings it back.
+
+Processes are started in a host with `start(host, argv, env=...)`; `dds_environment(host, discovery)` is the
+environment the README tells a lab to give each computer, nothing more. (Fast DDS does not take namespaces on one
+machine for one host: no data goes over shared memory between them, so a cut link stops every byte; the harness's
+own test checks this.)
+
+Everything is removed on exit, also when a test fails: the processes started in the lab are killed, the namespaces
+deleted (which deletes their interfaces). Labs left behind by a killed run (their creator's pid is gone) are removed
+when the next one starts. Needs root (CAP_NET_ADMIN) and `ip`; `unavailable()` says why a lab cannot be made here.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import time
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+from gryffin_ros.rosenv import profile_path
+
+PREFIX = "grlab"
+SUBNET = "10.213.7"  # /24 inside the lab only; host k gets SUBNET.(k + 1)
+
+
+def _ip(*args: str, check: bool = True) -> subprocess.CompletedProcess:
+    return subprocess.run(["ip", *args], check=check, capture_output=True, text=True, timeout=30)
+
+
+def unavailable() -> str | None:
+    """Why network namespaces cannot be made here (None when they can)."""
+    if shutil.which("ip") is None:
+        return "the 'ip' command (iproute2) is not installed"
+    if os.geteuid() != 0:
+        return "creating network namespaces needs root (CAP_NET_ADMIN); CI runs as root"
+    probe = f"{PREFIX}{os.getpid()}probe"
+    made = _ip("netns", "add", probe, check=False)
+    if made.returncode != 0:
+        return f"'ip netns add' is not permitted here: {made.stderr.strip()}"
+    _ip("netns", "del", probe, check=False)
+    return None
+
+
+def _remove_stale() -> None:
+    """Remove labs whose creating process is gone (a run killed before its cleanup)."""
+    listing = _ip("netns", "list", check=False).stdout.split("\n")
+    for line in listing:
+        name = line.split(" ")[0]
+        if not name.startswith(PREFIX):
+            continue
+        pid = name[len(PREFIX):].split("-")[0]
+        if pid.isdigit() and not Path(f"/proc/{pid}").exists():
+            _ip("netns", "del", name, check=False)
+
+
+class NetLab:
+    """Hosts `names` (short names, at most 10 characters) on one switch. Use as a context manager."""
+
+    def __init__(self, names: Sequence[str]):
+        if len(set(names)) != len(names) or any(not n.isalnum() or len(n) > 10 for n in names):
+            raise ValueError(f"host names must be distinct, alphanumeric, at most 10 characters: {list(names)}")
+        self.names = list(names)
+        self.tag = f"{PREFIX}{os.getpid()}-{id(self) % 10000}"
+        self.switch = f"{self.tag}-sw"
+        self.address = {name: f"{SUBNET}.{k + 1}" for k, name in enumerate(self.names)}
+        self.processes: list[subprocess.Popen] = []
+        self._made: list[str] = []
+
+    def namespace(self, host: str) -> str:
+        return f"{self.tag}-{host}"
+
+    # ---- lifetime ------------------------------------------------------------------------------------------
+    def __enter__(self) -> NetLab:
+        _remove_stale()
+        try:
+            self._create()
+        except BaseException:
+            self.close()
+            raise
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.close()
+
+    def _create(self) -> None:
+        _ip("netns", "add", self.switch)
+        self._made.append(self.switch)
+        _ip("-n", self.switch, "link", "add", "name", "br0", "type", "bridge")
+        _ip("-n", self.switch, "link", "set", "br0", "up")
+        _ip("-n", self.switch, "link", "set", "lo", "up")
+        for host in self.names:
+            ns = self.namespace(host)
+            _ip("netns", "add", ns)
+            self._made.append(ns)
+            _ip("-n", self.switch, "link", "add", "name", host, "type", "veth", "peer", "name", "eth0", "netns", ns)
+            _ip("-n", self.switch, "link", "set", "dev", host, "master", "br0")
+            _ip("-n", self.switch, "link", "set", "dev", host, "up")
+            _ip("-n", ns, "link", "set", "lo", "up")
+            _ip("-n", ns, "addr", "add", f"{self.address[host]}/24", "dev", "eth0")
+            _ip("-n", ns, "link", "set", "eth0", "up")
+            # multicast (DDS discovery with ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET) goes out of eth0, the only route
+            _ip("-n", ns, "route", "add", "224.0.0.0/4", "dev", "eth0")
+
+    def close(self) -> None:
+        for process in self.processes:
+            if process.poll() is None:
+                try:
+                    os.killpg(process.pid, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
+        for process in self.processes:
+            try:
+                process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                pass
+        for ns in reversed(self._made):
+            _ip("netns", "del", ns, check=False)
+        self._made.clear()
+
+    # ---- the network ---------------------------------------------------------------------------------------
+    def cut(self, host: str) -> None:
+        """Pull the host's cable: its port on the switch goes down."""
+        _ip("-n", self.switch, "link", "set", "dev", host, "down")
+
+    def restore(self, host: str) -> None:
+        _ip("-n", self.switch, "link", "set", "dev", host, "up")
+
+    def interfaces(self, host: str | None = None) -> list[str]:
+        """Names of the interfaces in a host's namespace (the switch's with None)."""
+        ns = self.switch if host is None else self.namespace(host)
+        out = _ip("-n", ns, "-o", "link", "show").stdout
+        return [line.split(":")[1].strip().split("@")[0] for line in out.splitlines() if line.strip()]
+
+    # ---- processes -----------------------------------------------------------------------------------------
+    def dds_environment(self, host: str, discovery: str, domain_id: int,
+                        base: Mapping[str, str] | None = None) -> dict[str, str]:
+        """What a lab computer exports (README, "Across machines"): one domain for the campaign, and either subnet
+        discovery (`discovery="subnet"`) or static peers — the other hosts' addresses — on top of local discovery
+        (`"static"`)."""
+        env = dict(os.environ if base is None else base)
+        env.pop("ROS_STATIC_PEERS", None)
+        env.update({"ROS_DOMAIN_ID": str(domain_id), "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp",
+                    "FASTRTPS_DEFAULT_PROFILES_FILE": profile_path()})
+        if discovery == "subnet":
+            env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "SUBNET"
+        elif discovery == "static":
+            env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+            env["ROS_STATIC_PEERS"] = ";".join(a for h, a in self.address.items() if h != host)
+        else:
+            raise ValueError(f"discovery must be 'subnet' or 'static', got {discovery!r}")
+        return env
+
+    def start(self, host: str, argv: Sequence[str], env: Mapping[str, str], **popen) -> subprocess.Popen:
+        """Start a process in the host's namespace (its own process group, killed when the lab closes)."""
+        process = subprocess.Popen(["ip", "netns", "exec", self.namespace(host), *argv], env=dict(env),
+                                   start_new_session=True, **popen)
+        self.processes.append(process)
+        return process
+
+
+def wait_until(condition, timeout: float, interval: float = 0.05) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        time.sleep(interval)
+    return condition()
