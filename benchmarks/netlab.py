@@ -19,10 +19,14 @@ when the next one starts. Needs root (CAP_NET_ADMIN) and `ip`; `unavailable()` s
 
 from __future__ import annotations
 
+import json
 import os
+import re
 import shutil
 import signal
+import sqlite3
 import subprocess
+import sys
 import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -175,3 +179,111 @@ def wait_until(condition, timeout: float, interval: float = 0.05) -> bool:
             return True
         time.sleep(interval)
     return condition()
+
+
+class LabCampaign:
+    """A flow-reactor campaign across a NetLab: the planner node on host `planner`, a claiming flow-reactor emulator
+    node (an instrument) on each of `instruments`, everyone with `discovery` ("static" or "subnet"). What happened is
+    read from the outside: the campaign store (SQLite, read-only while the planner writes) and the nodes' logs."""
+
+    def __init__(self, lab: NetLab, workdir: Path, config: Path, discovery: str, domain_id: int,
+                 planner: str = "planner", instruments: Sequence[str] = ("inst1", "inst2"),
+                 experiment_time_s: float = 0.5, batch_size: int = 2, seed: int = 0, python: str | None = None):
+        self.lab, self.workdir, self.config = lab, Path(workdir), Path(config)
+        self.discovery, self.domain_id = discovery, domain_id
+        self.planner, self.instruments = planner, list(instruments)
+        self.experiment_time_s, self.batch_size, self.seed = experiment_time_s, batch_size, seed
+        self.python = python or sys.executable
+        self.storage = self.workdir / "campaign.sqlite"
+        self.logs: dict[str, Path] = {}
+        self.processes: dict[str, subprocess.Popen] = {}
+
+    def _start(self, host: str, argv: list[str]) -> None:
+        env = self.lab.dds_environment(host, self.discovery, self.domain_id)
+        env["ROS_LOG_DIR"] = str(self.workdir / "ros_logs")
+        env["PYTHONUNBUFFERED"] = "1"
+        self.logs[host] = self.workdir / f"{host}.log"
+        with open(self.logs[host], "w") as log:
+            self.processes[host] = self.lab.start(host, [self.python, "-m", *argv], env, stdout=log,
+                                                  stderr=subprocess.STDOUT)
+
+    def start(self, timeout: float = 120.0) -> None:
+        self._start(self.planner, ["gryffin_ros.nodes.planner_node", "--ros-args", "-p", f"config:={self.config}",
+                                   "-p", f"storage:={self.storage}", "-p", f"seed:={self.seed}",
+                                   "-p", f"batch_size:={self.batch_size}", "-p", "auto_propose:=true"])
+        for k, host in enumerate(self.instruments):
+            self._start(host, ["gryffin_ros.nodes.emulator_node", "flow_reactor", "--ros-args",
+                               "-r", f"__node:=flow_reactor_{host}", "-p", "claim:=true",
+                               "-p", f"experiment_time_s:={self.experiment_time_s}", "-p", f"seed:={self.seed + k}"])
+        if not wait_until(lambda: self.alive() and ": active" in self.log(self.planner), timeout):
+            raise RuntimeError(f"the planner did not come up:\n{self.log(self.planner)[-3000:]}")
+
+    def alive(self) -> bool:
+        dead = {h: p.returncode for h, p in self.processes.items() if p.poll() is not None}
+        if dead:
+            raise RuntimeError(f"exited: {dead}\n" + "\n".join(f"--- {h}\n{self.log(h)[-3000:]}" for h in dead))
+        return True
+
+    def log(self, host: str) -> str:
+        return self.logs[host].read_text(errors="replace") if host in self.logs else ""
+
+    def stop(self, timeout: float = 60.0) -> dict[str, int]:
+        """SIGINT to every node (instruments first), as a lab would stop them; returns the exit codes."""
+        codes = {}
+        for host in [*self.instruments, self.planner]:
+            process = self.processes[host]
+            if process.poll() is None:
+                os.killpg(process.pid, signal.SIGINT)
+            try:
+                codes[host] = process.wait(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                os.killpg(process.pid, signal.SIGKILL)
+                codes[host] = process.wait()
+        return codes
+
+    # ---- what happened -------------------------------------------------------------------------------------
+    def _query(self, sql: str, args: tuple = ()) -> list[tuple]:
+        if not self.storage.exists():
+            return []
+        db = sqlite3.connect(f"file:{self.storage}?mode=ro", uri=True, timeout=30)
+        try:
+            return db.execute(sql, args).fetchall()
+        except sqlite3.OperationalError:  # the planner has not created its tables yet
+            return []
+        finally:
+            db.close()
+
+    def observations(self) -> list[tuple[str, float, str]]:
+        """(experiment_id, received, instrument) of every stored observation, in arrival order."""
+        rows = self._query("SELECT experiment_id, received, meta FROM observations ORDER BY seq")
+        return [(eid, received, json.loads(meta).get("instrument", "")) for eid, received, meta in rows]
+
+    def count(self) -> int:
+        rows = self._query("SELECT COUNT(*) FROM observations")
+        return rows[0][0] if rows else 0
+
+    def proposed_before(self, when: float) -> set[str]:
+        return {eid for (eid,) in self._query("SELECT experiment_id FROM proposals WHERE created < ?", (when,))}
+
+    def rejections(self) -> list[str]:
+        return [reason for (reason,) in self._query("SELECT reason FROM rejections ORDER BY seq")]
+
+    def measured(self, host: str) -> list[str]:
+        """Experiment ids the instrument on `host` ran, from its log ("measuring <id>")."""
+        return re.findall(r"measuring ([0-9a-f-]{36})", self.log(host))
+
+    def snapshot_measured(self) -> set[str]:
+        """The experiments measured so far, by any instrument."""
+        return {eid for host in self.instruments for eid in self.measured(host)}
+
+    def accounting(self, measured: set[str] | None = None) -> dict[str, int]:
+        """Experiments stored; run twice (by two instruments, or twice by one); lost: of `measured` (default: every
+        experiment any instrument ran), those not stored; reports sent again that the planner already had; other
+        refused reports."""
+        runs = [eid for host in self.instruments for eid in self.measured(host)]
+        stored = {eid for eid, _, _ in self.observations()}
+        rejections = self.rejections()
+        return {"stored": len(stored), "run_twice": len(runs) - len(set(runs)),
+                "lost": len((set(runs) if measured is None else measured) - stored),
+                "duplicate_reports": sum("already reported" in r for r in rejections),
+                "other_rejections": sum("already reported" not in r for r in rejections)}

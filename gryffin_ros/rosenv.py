@@ -1,6 +1,7 @@
 """The process environment every rclpy process of this project runs with: DDS discovery on loopback only, the
 fast-discovery Fast DDS profile; processes this project starts (tests, campaigns, benchmarks) get a ROS domain of their
-own when the caller has not chosen one, a node started by hand keeps ROS's default."""
+own when the caller has not chosen one, a node started by hand keeps ROS's default domain and the discovery range
+its caller exported (loopback when none)."""
 
 from __future__ import annotations
 
@@ -26,9 +27,14 @@ def ros_environment(base: Mapping[str, str] | None = None, domain_id: int | None
 
 
 def apply_to_this_process() -> None:
-    """Set the loopback-only environment in this process before rclpy initializes. The domain stays the caller's
-    (ROS's default 0 when unset): a node started by hand must be found by lab clients that export nothing."""
+    """Set the environment in this process before rclpy initializes: discovery on loopback and the fast-discovery
+    profile unless the caller chose otherwise. A node started by hand keeps the domain (ROS's default 0 when unset:
+    it must be found by lab clients that export nothing) and a discovery range the caller exported deliberately
+    (`ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET` on a lab network, README "Across machines")."""
     env = ros_environment()
-    if "ROS_DOMAIN_ID" not in os.environ:
-        del env["ROS_DOMAIN_ID"]
+    for key in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE"):
+        if os.environ.get(key):
+            env[key] = os.environ[key]
+        elif key == "ROS_DOMAIN_ID":
+            del env[key]
     os.environ.update(env)

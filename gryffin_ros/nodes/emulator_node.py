@@ -200,14 +200,16 @@ class EmulatorNode(Node):
         if time.monotonic() - started < self.experiment_time:
             return
         self.running = None
+        self.get_logger().info(f"measuring {proposal['experiment_id']}")
         try:
             result = self.emulator.measure(proposal["params"])
         except (KeyError, TypeError, ValueError) as exc:
             self.get_logger().warning(f"cannot emulate {proposal['experiment_id']}: {exc!r}; reported as failed")
             result = None
         failed = result is None or self.rng.random() < self.failure_rate
+        meta = {**(result or {}), "instrument": self.get_fully_qualified_name()}
         observation = typed.observation_message(proposal["experiment_id"], proposal["params"],
-                                                None if failed else {k: result[k] for k in self.objectives}, result)
+                                                None if failed else {k: result[k] for k in self.objectives}, meta)
         self.reported[proposal["experiment_id"]] = observation
         self.unacknowledged[proposal["experiment_id"]] = time.monotonic()
         self.publisher.publish(observation)

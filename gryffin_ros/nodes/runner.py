@@ -72,7 +72,8 @@ def environment_line() -> str:
     """What a lab client must match to see this node: domain, RMW, discovery range."""
     return (f"ROS_DOMAIN_ID={os.environ.get('ROS_DOMAIN_ID', '0 (unset: the ROS default)')}, "
             f"RMW_IMPLEMENTATION={os.environ.get('RMW_IMPLEMENTATION', 'default')}, "
-            f"ROS_AUTOMATIC_DISCOVERY_RANGE={os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE', 'default')}")
+            f"ROS_AUTOMATIC_DISCOVERY_RANGE={os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE', 'default')}"
+            + (f", ROS_STATIC_PEERS={os.environ['ROS_STATIC_PEERS']}" if os.environ.get("ROS_STATIC_PEERS") else ""))
 
 
 def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None,

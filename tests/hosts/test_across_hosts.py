@@ -1,0 +1,113 @@
+"""The planner on one host, two instruments on two others (network namespaces joined by a switch: real separate
+network stacks, real DDS over UDP between them), discovery set up as the README tells a lab: a closed-loop campaign
+with the instruments sharing the work, and network partitions in the middle of it."""
+
+import os
+import threading
+import time
+
+import pytest
+
+import netlab
+from gryffin_ros.paths import share_path
+
+REASON = netlab.unavailable()
+pytestmark = pytest.mark.skipif(REASON is not None, reason=f"network namespaces: {REASON}")
+
+CONFIG = share_path("examples") / "flow_reactor.yaml"
+BUDGET = 16
+CUT_S = 12.0  # longer than the DDS lease (10 s in gryffin_ros/resources/fastdds_profile.xml): peers drop each other
+HANG_S = 180.0
+
+
+@pytest.fixture
+def lab():
+    with netlab.NetLab(["planner", "inst1", "inst2"]) as made:
+        yield made
+
+
+def campaign(lab, tmp_path, discovery: str) -> netlab.LabCampaign:
+    domain = int(os.environ.get("ROS_DOMAIN_ID", "0") or 0)
+    run = netlab.LabCampaign(lab, tmp_path, CONFIG, discovery, domain)
+    run.start()
+    return run
+
+
+def reach(run: netlab.LabCampaign, count: int, timeout: float = HANG_S) -> None:
+    assert netlab.wait_until(lambda: run.alive() and run.count() >= count, timeout), \
+        f"{run.count()} of {count} experiments stored\n{run.log(run.planner)[-2000:]}"
+
+
+def finish(run: netlab.LabCampaign, before: float | None = None) -> dict[str, int]:
+    """Run to the budget, then check: everything measured by then is stored (its report may still be on its
+    way: sent again until acknowledged), and every experiment proposed before `before` was completed."""
+    reach(run, BUDGET)
+    measured = run.snapshot_measured()
+    owed = run.proposed_before(before) if before is not None else set()
+    stored = lambda: {eid for eid, _, _ in run.observations()}  # noqa: E731
+    assert netlab.wait_until(lambda: run.alive() and measured | owed <= stored(), 60.0), \
+        f"not stored: {sorted(measured - stored())}, owed and not done: {sorted(owed - stored())}"
+    accounting = run.accounting(measured)
+    codes = run.stop()
+    assert codes == {h: 0 for h in codes}, codes
+    assert accounting["lost"] == 0 and accounting["run_twice"] == 0 and accounting["other_rejections"] == 0, \
+        accounting
+    return accounting
+
+
+def test_the_lab_network_is_the_namespaces_alone(lab):
+    for host in lab.names:
+        assert lab.interfaces(host) == ["lo", "eth0"]
+    assert sorted(lab.interfaces()) == sorted(["lo", "br0", *lab.names])  # the switch: no port to the machine
+
+
+def test_two_instruments_share_a_campaign_across_hosts(lab, tmp_path):
+    run = campaign(lab, tmp_path, "subnet")  # static peers: the tests below
+    finish(run)
+    by = [instrument for _, _, instrument in run.observations()]
+    assert {i.rsplit("_", 1)[-1] for i in by} == {"inst1", "inst2"}, by  # both took part
+
+
+def test_an_instrument_cut_off_for_longer_than_the_lease(lab, tmp_path):
+    run = campaign(lab, tmp_path, "static")
+    reach(run, 4)
+    lab.cut("inst1")
+    cut_at = time.time()
+    time.sleep(CUT_S)  # the partition itself: its length is the experiment
+    during = [i for _, received, i in run.observations() if received > cut_at]
+    lab.restore("inst1")
+    restored = time.time()
+    assert during and all(i.endswith("inst2") for i in during), during  # the other instrument went on alone
+    finish(run, before=restored)
+    back = [received for _, received, i in run.observations() if i.endswith("inst1") and received > restored]
+    assert back, "the cut instrument never reported again"
+
+
+def test_the_planner_cut_off_for_longer_than_the_lease(lab, tmp_path):
+    run = campaign(lab, tmp_path, "subnet")
+    reach(run, 4)
+    lab.cut("planner")
+    time.sleep(CUT_S)
+    lab.restore("planner")
+    restored = time.time()
+    finish(run, before=restored)
+    assert {i.rsplit("_", 1)[-1] for _, received, i in run.observations() if received > restored} == {"inst1", "inst2"}
+
+
+def test_a_flapping_planner_link(lab, tmp_path):
+    run = campaign(lab, tmp_path, "static")
+    stop = threading.Event()
+
+    def flap():  # down 1 s in every 5 s, for the whole campaign
+        while not stop.wait(4.0):
+            lab.cut("planner")
+            stop.wait(1.0)
+            lab.restore("planner")
+    flapper = threading.Thread(target=flap, daemon=True)
+    flapper.start()
+    try:
+        accounting = finish(run)
+    finally:
+        stop.set()
+        flapper.join()
+    assert accounting["stored"] >= BUDGET
