@@ -6,9 +6,9 @@ import os
 import threading
 import time
 
+import netlab
 import pytest
 
-import netlab
 from gryffin_ros.paths import share_path
 
 REASON = netlab.unavailable()
@@ -61,20 +61,14 @@ def test_the_lab_network_is_the_namespaces_alone(lab):
     assert sorted(lab.interfaces()) == sorted(["lo", "br0", *lab.names])  # the switch: no port to the machine
 
 
-def test_two_instruments_share_a_campaign_across_hosts(lab, tmp_path):
-    run = campaign(lab, tmp_path, "subnet")  # static peers: the tests below
-    finish(run)
-    by = [instrument for _, _, instrument in run.observations()]
-    assert {i.rsplit("_", 1)[-1] for i in by} == {"inst1", "inst2"}, by  # both took part
-
-
 def test_an_instrument_cut_off_for_longer_than_the_lease(lab, tmp_path):
     run = campaign(lab, tmp_path, "static")
     reach(run, 4)
     lab.cut("inst1")
     cut_at = time.time()
     time.sleep(CUT_S)  # the partition itself: its length is the experiment
-    during = [i for _, received, i in run.observations() if received > cut_at]
+    # a report on the wire at the moment of the cut may still be stored just after it: look from 1 s on
+    during = [i for _, received, i in run.observations() if received > cut_at + 1.0]
     lab.restore("inst1")
     restored = time.time()
     assert during and all(i.endswith("inst2") for i in during), during  # the other instrument went on alone
@@ -84,6 +78,7 @@ def test_an_instrument_cut_off_for_longer_than_the_lease(lab, tmp_path):
 
 
 def test_the_planner_cut_off_for_longer_than_the_lease(lab, tmp_path):
+    """Also the plain shared campaign: both instruments take experiments, subnet discovery."""
     run = campaign(lab, tmp_path, "subnet")
     reach(run, 4)
     lab.cut("planner")
