@@ -9,8 +9,8 @@ side, as a pulled cable: the host's `eth0` loses its carrier), `restore(host)` b
 
 Processes are started in a host with `start(host, argv, env=...)`; `dds_environment(host, discovery)` is the
 environment the README tells a lab to give each computer, nothing more. (Fast DDS does not take namespaces on one
-machine for one host: no data goes over shared memory between them, so a cut link stops every byte; the harness's
-own test checks this.)
+machine for one host: no data goes over shared memory between them, so a cut link stops every byte: seen with a
+talker/listener pair, and tests/hosts checks that a cut instrument's results stop arriving during its cut.)
 
 Everything is removed on exit, also when a test fails: the processes started in the lab are killed, the namespaces
 deleted (which deletes their interfaces). Labs left behind by a killed run (their creator's pid is gone) are removed
