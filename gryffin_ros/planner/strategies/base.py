@@ -71,6 +71,9 @@ class BasePlanner:
         self.seed = int(seed)
         self.observations: list[Observation] = []
         self._observed: np.ndarray | None = None  # observed_points() of the observations so far (they only grow)
+        self._successful: tuple[Observation, ...] = ()  # successful_values() of the first _values_upto observations
+        self._values = np.empty((0, len(self.objectives)))
+        self._values_upto = 0
         self.pending: dict[str, Proposal] = {}
         self._ask_count = 0
         self._proposal_count = 0
@@ -182,12 +185,33 @@ class BasePlanner:
     def pending_points(self) -> np.ndarray:
         return self._internal([p.params for p in self.pending.values()])
 
+    def successful_values(self) -> tuple[tuple[Observation, ...], np.ndarray]:
+        """The successful observations so far and their (n, objectives) values in users' units, read-only; grown as
+        observations are recorded (collecting them from every record took several ms per observation at
+        thousands: the node's acknowledgement of each result waited for it)."""
+        if self._values_upto < len(self.observations):
+            new = [o for o in self.observations[self._values_upto:] if not o.failed]
+            if new:
+                values = np.concatenate([self._values, self._objective_matrix(new)])
+                values.flags.writeable = False
+                self._successful, self._values = self._successful + tuple(new), values
+            self._values_upto = len(self.observations)
+        return self._successful, self._values
+
+    def _objective_matrix(self, observations: Sequence[Observation]) -> np.ndarray:
+        return np.array([[o.objectives[obj.name] for obj in self.objectives] for o in observations], dtype=float)
+
     def merits(self, observations: Sequence[Observation], transform: bool = True) -> np.ndarray:
         """Successful observations -> minimization merits in [0, 1]: one objective rescaled (max goals negated),
         several scalarized by Chimera; then (transform) the objective transform (sqrt by default)."""
         if not observations:
             return np.empty(0)
-        Y = np.array([[o.objectives[obj.name] for obj in self.objectives] for o in observations], dtype=float)
+        return self.merits_of_values(self._objective_matrix(observations), transform)
+
+    def merits_of_values(self, Y: np.ndarray, transform: bool = True) -> np.ndarray:
+        """`merits` of the (n, objectives) values of successful observations."""
+        if len(Y) == 0:
+            return np.empty(0)
         if len(self.objectives) > 1:
             f = Chimera(self.objectives, self.config.general.softness).merits(Y)
         else:
@@ -197,9 +221,10 @@ class BasePlanner:
         return OBJ_TRANSFORMS[self.config.general.obj_transform][0](f) if transform else f
 
     def best(self) -> Observation | None:
-        """The best successful observation so far (None before the first one)."""
-        from ..progress import best_of
-        return best_of(self, self.observations)
+        """The best successful observation so far (None before the first one): `progress.best_of` of every
+        observation, from the values kept as they arrive."""
+        successful, values = self.successful_values()
+        return successful[int(np.argmin(self.merits_of_values(values, transform=False)))] if successful else None
 
     # ---- proposals -------------------------------------------------------------------------------------------
     def ask(self, n: int | None = None) -> list[Proposal]:
