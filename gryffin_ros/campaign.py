@@ -22,6 +22,7 @@ and no other instrument is given those experiments, also after a restart (claims
 from __future__ import annotations
 
 import copy
+import ctypes
 import logging
 import threading
 import uuid
@@ -46,6 +47,23 @@ ConstraintArg = Callable[[dict], bool] | Sequence[Callable[[dict], bool]] | None
 class Rejected(GryffinRosError):
     """An observation the campaign refuses for its id (already reported, or never proposed); nothing is stored."""
 
+
+def _malloc_trim() -> Callable[[int], int] | None:
+    try:
+        return ctypes.CDLL(None).malloc_trim  # the C library this process runs on
+    except (OSError, AttributeError):  # not glibc (musl, macOS): the allocator's own policy stands
+        return None
+
+
+_MALLOC_TRIM = _malloc_trim()
+
+
+def give_back_freed_memory() -> None:
+    """Return heap memory freed by an ask to the system. An ask allocates and frees matrices of tens of MB; glibc
+    keeps freed blocks for reuse, so a long campaign's resident memory rose with the largest ask so far (a campaign
+    of 1250 experiments in one process: 487 MB, with this after each ask 345 MB; about 5 ms per call)."""
+    if _MALLOC_TRIM is not None:
+        _MALLOC_TRIM(0)
 
 class CampaignClosed(GryffinRosError):
     """The campaign has been closed (the process is shutting down); nothing more is stored."""
@@ -275,7 +293,10 @@ class Campaign:
         proposals: list[Proposal] = []
         try:
             self._absorb()
-            proposals = self.planner.ask(n)
+            try:
+                proposals = self.planner.ask(n)
+            finally:
+                give_back_freed_memory()
             self.store.add_proposals(proposals, {"ask_count": str(self.planner.ask_count),
                                                  "proposal_count": str(self.planner.proposal_count)})
         except BaseException as exc:

@@ -267,3 +267,21 @@ def test_a_proposal_stopped_at_a_checkpoint_leaves_nothing_behind_and_the_next_d
     assert stopped.pending == [] and stopped.status()["state"] == "idle"
     again, reference = stopped.propose(2), plain.propose(2)
     assert [p.params for p in again] == [p.params for p in reference]
+
+
+def test_every_ask_gives_its_freed_memory_back_also_when_it_fails(tmp_path, monkeypatch):
+    """glibc keeps an ask's freed matrices for reuse unless told to return them: without this, a long campaign's
+    resident memory rose with its largest ask (benchmarks/soak.py)."""
+    from gryffin_ros import campaign as module
+    calls = []
+    monkeypatch.setattr(module, "give_back_freed_memory", lambda: calls.append("trim"))
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    asked = campaign.planner.ask
+    monkeypatch.setattr(campaign.planner, "ask", lambda n=None: calls.append("ask") or asked(n))
+    campaign.propose(2)
+    assert calls == ["ask", "trim"]
+    monkeypatch.setattr(campaign.planner, "ask", lambda n=None: calls.append("ask") or 1 / 0)
+    with pytest.raises(ZeroDivisionError):
+        campaign.propose(1)
+    assert calls == ["ask", "trim", "ask", "trim"]
+    campaign.close()
