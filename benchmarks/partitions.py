@@ -195,8 +195,8 @@ def main(argv=None) -> int:
     command = ".venv/bin/python benchmarks/partitions.py " + " ".join(argv if argv is not None else sys.argv[1:])
     out.with_suffix(".json").write_text(json.dumps({"command": command.strip(), "budget": args.budget,
                                                     "results": results}, indent=1) + "\n")
-    out.with_suffix(".md").write_text(f"`{command.strip()}` as root (budget {args.budget}, batch 2, 0.5 s per experiment, two claiming instruments)\n\n"
-                                      + table(results) + "\n")
+    setting = f"budget {args.budget}, batch 2, 0.5 s per experiment, two claiming instruments"
+    out.with_suffix(".md").write_text(f"`{command.strip()}` as root ({setting})\n\n" + table(results) + "\n")
     print(table(results))
     bad = [r["scenario"] for r in results if r["lost"] or r["run_twice"] or r["owed_not_done"]
            or any(r["exit_codes"].values())]

@@ -71,7 +71,7 @@ def test_the_best_kept_as_observations_arrive_is_the_best_of_all_of_them():
     rng = np.random.default_rng(3)
     planner = Planner(config, seed=0)
     assert planner.best() is None
-    for chunk in range(12):  # relative ranges move as data arrive: the best can change to an earlier observation
+    for _ in range(12):  # relative ranges move as data arrive: the best can change to an earlier observation
         rows = [{"x": float(x), "X1_X2": float(y) if rng.random() > 0.2 else None, "cost": float(c)}
                 for x, y, c in zip(rng.random(5), rng.uniform(0.5, 1.0, 5), rng.uniform(0.001, 0.01, 5))]
         planner.tell(rows)
