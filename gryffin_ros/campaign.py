@@ -65,6 +65,7 @@ def give_back_freed_memory() -> None:
     if _MALLOC_TRIM is not None:
         _MALLOC_TRIM(0)
 
+
 class CampaignClosed(GryffinRosError):
     """The campaign has been closed (the process is shutting down); nothing more is stored."""
 
