@@ -28,7 +28,7 @@ import sqlite3
 import subprocess
 import sys
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 from gryffin_ros.rosenv import profile_path
@@ -240,6 +240,22 @@ class LabCampaign:
                 os.killpg(process.pid, signal.SIGKILL)
                 codes[host] = process.wait()
         return codes
+
+    def settle(self, budget: int, owed: Iterable[str] = (), timeout: float = 180.0, settle_s: float = 60.0
+               ) -> dict:
+        """Run to `budget` stored observations; then wait (up to `settle_s`) until every experiment measured by then
+        and every one of `owed` is stored (a report may still be on its way: instruments send again until
+        acknowledged); stop the nodes. Returns `accounting` of what was measured by then, with owed_not_done (of
+        `owed`, not stored), settled (everything was stored in time) and the nodes' exit_codes."""
+        if not wait_until(lambda: self.alive() and self.count() >= budget, timeout):
+            raise RuntimeError(f"{self.count()} of {budget} experiments stored after {timeout:.0f} s\n"
+                               f"{self.log(self.planner)[-3000:]}")
+        measured, owed = self.snapshot_measured(), set(owed)
+        stored = lambda: {eid for eid, _, _ in self.observations()}  # noqa: E731
+        settled = wait_until(lambda: self.alive() and measured | owed <= stored(), settle_s)
+        result = self.accounting(measured)
+        result.update(owed_not_done=len(owed - stored()), settled=settled, exit_codes=self.stop())
+        return result
 
     # ---- what happened -------------------------------------------------------------------------------------
     def _query(self, sql: str, args: tuple = ()) -> list[tuple]:

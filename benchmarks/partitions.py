@@ -53,22 +53,6 @@ def first_after(run: netlab.LabCampaign, when: float, side: str | None, timeout:
     return None if hit is None else hit - when
 
 
-def finish(run: netlab.LabCampaign, budget: int, owed: set[str]) -> dict:
-    """Run to the budget; wait until everything measured by then and everything owed is stored; stop; account."""
-    started = time.monotonic()
-    if not netlab.wait_until(lambda: run.alive() and run.count() >= budget, HANG_S):
-        raise RuntimeError(f"{run.count()} of {budget} stored after {HANG_S:.0f} s\n{run.log(run.planner)[-3000:]}")
-    measured = run.snapshot_measured()
-    stored = lambda: {eid for eid, _, _ in run.observations()}  # noqa: E731
-    settled = netlab.wait_until(lambda: run.alive() and measured | owed <= stored(), 120.0)
-    accounting = run.accounting(measured)
-    accounting["owed_not_done"] = len(owed - stored())
-    accounting["settled"] = settled
-    accounting["exit_codes"] = run.stop()
-    accounting["to_budget_after_s"] = time.monotonic() - started
-    return accounting
-
-
 def owed_at(run: netlab.LabCampaign, when: float) -> set[str]:
     stored = {eid for eid, _, _ in run.observations()}
     return run.proposed_before(when) - stored
@@ -90,7 +74,7 @@ def cut_scenario(lab: netlab.NetLab, workdir: Path, args, discovery: str, host: 
     owed = owed_at(run, restored)
     side = host if host in run.instruments else None
     recover = first_after(run, restored, side)
-    result = finish(run, args.budget, owed)
+    result = run.settle(args.budget, owed, HANG_S, settle_s=120.0)
     result.update({"scenario": f"{'instrument' if side else 'planner'} cut {seconds:g} s", "discovery": discovery,
                    "cut_s": seconds, "owed": len(owed), "recover_s": recover,
                    "stored_during_cut": len(during),
@@ -124,7 +108,7 @@ def flap_scenario(lab: netlab.NetLab, workdir: Path, args, discovery: str, down:
     observed = sorted(received for _, received, _ in run.observations())
     # recovery after each return: to the next stored observation (returns after the last one are not counted)
     gaps = [next(t for t in observed if t > back) - back for back in returns if observed and observed[-1] > back]
-    result = finish(run, args.budget, set())
+    result = run.settle(args.budget, (), HANG_S, settle_s=120.0)
     result.update({"scenario": f"planner link down {down:g} s in every {period:g} s", "discovery": discovery,
                    "returns": len(returns), "recover_s": statistics.median(gaps) if gaps else None,
                    "recover_max_s": max(gaps) if gaps else None, "owed": None, "wall_s": time.monotonic() - begun})

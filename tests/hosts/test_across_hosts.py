@@ -38,21 +38,15 @@ def reach(run: netlab.LabCampaign, count: int, timeout: float = HANG_S) -> None:
         f"{run.count()} of {count} experiments stored\n{run.log(run.planner)[-2000:]}"
 
 
-def finish(run: netlab.LabCampaign, before: float | None = None) -> dict[str, int]:
-    """Run to the budget, then check: everything measured by then is stored (its report may still be on its
-    way: sent again until acknowledged), and every experiment proposed before `before` was completed."""
-    reach(run, BUDGET)
-    measured = run.snapshot_measured()
+def finish(run: netlab.LabCampaign, before: float | None = None) -> dict:
+    """Run to the budget, then check: everything measured by then is stored (its report may still be on its way:
+    sent again until acknowledged), and every experiment proposed before `before` was completed."""
     owed = run.proposed_before(before) if before is not None else set()
-    stored = lambda: {eid for eid, _, _ in run.observations()}  # noqa: E731
-    assert netlab.wait_until(lambda: run.alive() and measured | owed <= stored(), 60.0), \
-        f"not stored: {sorted(measured - stored())}, owed and not done: {sorted(owed - stored())}"
-    accounting = run.accounting(measured)
-    codes = run.stop()
-    assert codes == {h: 0 for h in codes}, codes
-    assert accounting["lost"] == 0 and accounting["run_twice"] == 0 and accounting["other_rejections"] == 0, \
-        accounting
-    return accounting
+    result = run.settle(BUDGET, owed, HANG_S)
+    assert result["exit_codes"] == {h: 0 for h in result["exit_codes"]}, result
+    assert result["settled"] and result["lost"] == 0 and result["owed_not_done"] == 0, result
+    assert result["run_twice"] == 0 and result["other_rejections"] == 0, result
+    return result
 
 
 def test_the_lab_network_is_the_namespaces_alone(lab):
