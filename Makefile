@@ -17,7 +17,7 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export FASTRTPS_DEFAULT_PROFILES_FILE := $(CURDIR)/gryffin_ros/resources/fastdds_profile.xml
 export RMW_IMPLEMENTATION := rmw_fastrtps_cpp
 
-.PHONY: venv demo test lint lock
+.PHONY: venv demo test check lint lock
 
 $(STAMP): setup.py constraints.txt $(LOCK)
 	$(PYTHON) -m venv $(VENV)
@@ -46,9 +46,15 @@ venv: $(STAMP) $(MSGS)
 demo: venv
 	$(VENV)/bin/gryffin-ros campaign
 
-# Each test run gets its own ROS domain (1-101) so parallel runs on one machine never see each other.
+# Each test run gets its own ROS domain (1-101) so parallel runs on one machine never see each other; the suite runs
+# on two pytest-xdist workers, and each worker moves to a domain of its own (tests/conftest.py).
+PYTEST := ROS_DOMAIN_ID=$${ROS_DOMAIN_ID:-$$(( $$$$ % 101 + 1 ))} ROS_LOG_DIR=$$(mktemp -d) $(PY) -m pytest -q -n 2 --dist worksteal
 test: venv
-	ROS_DOMAIN_ID=$${ROS_DOMAIN_ID:-$$(( $$$$ % 101 + 1 ))} ROS_LOG_DIR=$$(mktemp -d) $(PY) -m pytest -q tests
+	$(PYTEST) --durations=15 tests
+
+# The fast tier for the inner loop: no DDS, no browser, not the statistical learning tests (markers in pytest.ini).
+check: venv
+	$(PYTEST) -m "not ros and not browser and not slow" tests
 
 lint: venv
 	$(VENV)/bin/ruff check gryffin_ros tests benchmarks

@@ -37,7 +37,8 @@ setup(
     ],
     extras_require={
         # selenium drives Debian's chromium (chromium-driver) in the dashboard's browser tests
-        "test": ["pytest>=8", "hypothesis>=6", "ruff>=0.5", "selenium>=4.10"],
+        # pytest-xdist: make test and make check run on two workers (the two cores)
+        "test": ["pytest>=8", "pytest-xdist>=3.2", "hypothesis>=6", "ruff>=0.5", "selenium>=4.10"],
         "ros": ["ros-jazzy-rclpy", "ros-jazzy-common-interfaces", "ros-jazzy-rmw-fastrtps-cpp"],
         # what msg_schemas/build.sh needs to generate the typed interfaces gryffin_ros_msgs (the meta wheels do not
         # bring the generators' own dependencies; without one, cmake stops at it)

@@ -33,6 +33,12 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from std_msgs.msg import String  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
+from gryffin_ros.nodes.supervisor import Supervisor, signals_as_interrupt  # noqa: E402
+
+# every node this benchmark starts: stopped when it ends or is stopped (SIGINT, SIGTERM, SIGHUP), and gone by
+# itself when this process is killed
+NODES = Supervisor(stop_timeout_s=120.0)
+
 CONFIG = {
     "name": "load",
     "parameters": [{"name": "F_C", "type": "continuous", "low": 0.0, "high": 200.0},
@@ -88,11 +94,11 @@ def main() -> None:
         work = Path(tmp)
         (work / "config.yaml").write_text(yaml.safe_dump(CONFIG))
         store = work / "load.sqlite"
-        planner = subprocess.Popen(
-            [sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-p",
-             f"config:={work / 'config.yaml'}", "-p", f"storage:={store}", "-p", "seed:=0", "-p",
-             "auto_propose:=false", "-p", "accept_unsolicited:=true"],
-            env={**os.environ, "ROS_LOG_DIR": str(work)}, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        planner = NODES.start(
+            "planner node", [sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-p",
+                             f"config:={work / 'config.yaml'}", "-p", f"storage:={store}", "-p", "seed:=0", "-p",
+                             "auto_propose:=false", "-p", "accept_unsolicited:=true"],
+            {**os.environ, "ROS_LOG_DIR": str(work)}, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         rclpy.init()
         node = rclpy.create_node("load_client")
         publisher = node.create_publisher(String, "/gryffin_planner/json/observations", KEEP_ALL)
@@ -156,4 +162,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with signals_as_interrupt(), NODES:
+        main()

@@ -31,6 +31,7 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
+from gryffin_ros.nodes.supervisor import Supervisor
 from gryffin_ros.rosenv import profile_path
 
 PREFIX = "grlab"
@@ -77,7 +78,9 @@ class NetLab:
         self.tag = f"{PREFIX}{os.getpid()}-{id(self) % 10000}"
         self.switch = f"{self.tag}-sw"
         self.address = {name: f"{SUBNET}.{k + 1}" for k, name in enumerate(self.names)}
-        self.processes: list[subprocess.Popen] = []
+        # every process started in a host is owned by a supervisor: stopped when the lab closes, and gone by itself
+        # when the process holding the lab is killed (gryffin_ros.nodes.supervisor)
+        self.supervisor = Supervisor(stop_timeout_s=10.0, kill_timeout_s=5.0)
         self._made: list[str] = []
 
     def namespace(self, host: str) -> str:
@@ -115,18 +118,12 @@ class NetLab:
             # multicast (DDS discovery with ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET) goes out of eth0, the only route
             _ip("-n", ns, "route", "add", "224.0.0.0/4", "dev", "eth0")
 
+    @property
+    def processes(self) -> list[subprocess.Popen]:
+        return self.supervisor.processes
+
     def close(self) -> None:
-        for process in self.processes:
-            if process.poll() is None:
-                try:
-                    os.killpg(process.pid, signal.SIGKILL)
-                except ProcessLookupError:
-                    pass
-        for process in self.processes:
-            try:
-                process.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                pass
+        self.supervisor.stop()  # what is still running (a campaign normally stops its nodes itself, in order)
         for ns in reversed(self._made):
             _ip("netns", "del", ns, check=False)
         self._made.clear()
@@ -165,11 +162,8 @@ class NetLab:
         return env
 
     def start(self, host: str, argv: Sequence[str], env: Mapping[str, str], **popen) -> subprocess.Popen:
-        """Start a process in the host's namespace (its own process group, killed when the lab closes)."""
-        process = subprocess.Popen(["ip", "netns", "exec", self.namespace(host), *argv], env=dict(env),
-                                   start_new_session=True, **popen)
-        self.processes.append(process)
-        return process
+        """Start a process in the host's namespace (its own process group, stopped when the lab closes)."""
+        return self.supervisor.start(host, ["ip", "netns", "exec", self.namespace(host), *argv], env, **popen)
 
 
 def wait_until(condition, timeout: float, interval: float = 0.05) -> bool:

@@ -36,6 +36,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import netlab  # noqa: E402
 
+from gryffin_ros.nodes.supervisor import signals_as_interrupt  # noqa: E402
 from gryffin_ros.paths import share_path  # noqa: E402
 
 CONFIG = share_path("examples") / "flow_reactor.yaml"
@@ -190,4 +191,5 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    with signals_as_interrupt():  # the NetLab closes (its nodes stopped) on SIGTERM and SIGHUP too
+        sys.exit(main())

@@ -34,6 +34,11 @@ from std_msgs.msg import String  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
 from gryffin_ros.nodes.qos import EVENTS_QOS, OBSERVATIONS_QOS  # noqa: E402
+from gryffin_ros.nodes.supervisor import Supervisor, signals_as_interrupt  # noqa: E402
+
+# every node this benchmark starts: stopped when it ends or is stopped (SIGINT, SIGTERM, SIGHUP), and gone by
+# itself when this process is killed
+NODES = Supervisor(stop_timeout_s=120.0)
 from gryffin_ros.nodes.typed import parameter_values  # noqa: E402
 
 # the long recommendation that is canceled: the genetic optimizer over six continuous parameters, 400 points
@@ -52,11 +57,11 @@ def wait(future, timeout: float = 120.0):
 
 
 def start_planner(config: Path, workdir: Path, name: str) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-r",
-                             f"__ns:=/{name}", "-p", f"config:={config}", "-p",
-                             f"storage:={workdir / (name + '.sqlite')}", "-p", "seed:=0", "-p", "auto_propose:=false"],
-                            env={**os.environ, "ROS_LOG_DIR": str(workdir)}, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    return NODES.start(f"planner node {name}", [
+        sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-r", f"__ns:=/{name}", "-p",
+        f"config:={config}", "-p", f"storage:={workdir / (name + '.sqlite')}", "-p", "seed:=0", "-p",
+        "auto_propose:=false"], {**os.environ, "ROS_LOG_DIR": str(workdir)}, stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL)
 
 
 class Lab:
@@ -223,4 +228,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with signals_as_interrupt(), NODES:
+        main()

@@ -41,6 +41,11 @@ from gryffin_ros.campaign import Campaign  # noqa: E402
 from gryffin_ros.cli.progress import BestSoFar  # noqa: E402
 from gryffin_ros.emulators import FlowReactorEmulator  # noqa: E402
 from gryffin_ros.nodes.qos import EVENTS_QOS, OBSERVATIONS_SUBSCRIPTION_QOS  # noqa: E402
+from gryffin_ros.nodes.supervisor import Supervisor, signals_as_interrupt  # noqa: E402
+
+# every node this benchmark starts: stopped when it ends or is stopped (SIGINT, SIGTERM, SIGHUP), and gone by
+# itself when this process is killed
+NODES = Supervisor(stop_timeout_s=120.0)
 from gryffin_ros.planner.config import load_config  # noqa: E402
 from gryffin_ros.storage import CampaignStore  # noqa: E402
 
@@ -170,10 +175,10 @@ def over_ros(args: argparse.Namespace, work: Path, config) -> tuple[list[dict], 
     env = {**os.environ, "ROS_LOG_DIR": str(work / "logs")}
     planner_cmd = [sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args", "-p", f"config:={CONFIG}",
                    "-p", f"storage:={store}", "-p", "seed:=0", "-p", f"batch_size:={args.batch}"]
-    planner = subprocess.Popen(planner_cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    emulator = subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.emulator_node", "flow_reactor",
-                                 "--ros-args", "-p", "seed:=0", "-p", "objectives:=[X1_X2,cost]"], env=env,
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    planner = NODES.start("planner node", planner_cmd, env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    emulator = NODES.start("emulator node", [sys.executable, "-m", "gryffin_ros.nodes.emulator_node", "flow_reactor",
+                                             "--ros-args", "-p", "seed:=0", "-p", "objectives:=[X1_X2,cost]"], env,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     watcher = Watcher()
     rows, best, started = [], {}, time.perf_counter()
     try:
@@ -200,16 +205,13 @@ def over_ros(args: argparse.Namespace, work: Path, config) -> tuple[list[dict], 
         planner.send_signal(signal.SIGINT)
         planner.wait(timeout=120)
         restart_started = time.perf_counter()
-        planner = subprocess.Popen(planner_cmd + ["-p", "auto_propose:=false"], env=env, stdout=subprocess.DEVNULL,
-                                   stderr=subprocess.DEVNULL)
+        planner = NODES.start("planner node", planner_cmd + ["-p", "auto_propose:=false"], env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         restart = watcher.ready_after(restart_started, args.budget)
         single = watcher.single_asks(5)
     finally:
         watcher.close()
-        for process in (planner, emulator):
-            if process.poll() is None:
-                process.send_signal(signal.SIGINT)
-                process.wait(timeout=120)
+        NODES.stop()
     export_started = time.perf_counter()
     subprocess.run([sys.executable, "-m", "gryffin_ros.cli", "export", str(store), "--csv", str(work / "soak.csv")],
                    check=True, capture_output=True)
@@ -309,4 +311,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with signals_as_interrupt(), NODES:
+        main()

@@ -51,3 +51,23 @@ def clean() -> None:
     """Remove the files of dead participants with Fast DDS's own tool (its exit status is checked, its text is not)."""
     tool = Path(sys.executable).with_name("fastdds")
     subprocess.run([str(tool), "shm", "clean"], capture_output=True, check=True, timeout=180)
+
+
+def held_by(pid: int) -> set[str]:
+    """The Fast DDS lock files a running process holds open now (its ports and segments): what it leaves behind if
+    it dies without cleaning up. Judging only these keeps a check to its own test's processes, whatever other
+    DDS processes (a parallel test worker's) do meanwhile."""
+    held = set()
+    fd_dir = Path("/proc") / str(pid) / "fd"
+    try:
+        entries = os.listdir(fd_dir)
+    except OSError:
+        return held
+    for entry in entries:
+        try:
+            target = Path(os.readlink(fd_dir / entry))
+        except OSError:
+            continue
+        if target.parent == SHM_DIR and LOCK_FILE.match(target.name):
+            held.add(target.name)
+    return held

@@ -4,6 +4,8 @@ import csv
 import subprocess
 import sys
 
+import pytest
+
 from gryffin_ros.emulators import RedoxEmulator
 from gryffin_ros.paths import share_path
 from gryffin_ros.planner import Planner
@@ -55,6 +57,7 @@ def test_short_redox_run_proposes_only_synthesizable_candidates():
     assert planner.descriptor_summary()  # dynamic descriptors learned something to report
 
 
+@pytest.mark.ros
 def test_redox_campaign_over_ros(tmp_path):
     result = subprocess.run([sys.executable, "-m", "gryffin_ros.cli", "campaign", "--config",
                              str(EXAMPLES / "redox_flow_battery.yaml"), "--budget", "6", "--seed", "2", "--out",

@@ -5,7 +5,6 @@ output folder (store, CSV, plot)."""
 from __future__ import annotations
 
 import argparse
-import signal
 import subprocess
 import sys
 import time
@@ -13,6 +12,7 @@ from pathlib import Path
 
 from ..campaign import Campaign
 from ..emulators import FlowReactorEmulator, RedoxEmulator
+from ..nodes.supervisor import Interrupted, Supervisor, signals_as_interrupt
 from ..paths import share_path
 from ..planner import GryffinRosError
 from ..planner.config import PlannerConfig, load_config
@@ -58,22 +58,9 @@ def run_local(config_path: str, config: PlannerConfig, store_path: Path, args: a
                 progress.show(campaign.n_observations, best.objectives if best else None)
 
 
-def stop(processes: list[subprocess.Popen], env: dict[str, str]) -> None:
-    """SIGINT (clean rclpy shutdown), then SIGTERM, then SIGKILL; then Fast DDS shared memory left by dead
-    participants is removed (a node interrupted mid-callback sometimes leaves some even when it exits cleanly)."""
-    for process in processes:
-        if process.poll() is None:
-            process.send_signal(signal.SIGINT)
-    for process in processes:
-        try:
-            process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            process.terminate()
-            try:
-                process.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait()
+def clean_shared_memory(env: dict[str, str]) -> None:
+    """Remove Fast DDS shared memory left by dead participants (a node interrupted mid-callback sometimes leaves
+    some even when it exits cleanly)."""
     fastdds = Path(sys.executable).with_name("fastdds")
     if fastdds.exists():
         subprocess.run([str(fastdds), "shm", "clean"], env=env, capture_output=True, timeout=30)
@@ -94,12 +81,14 @@ def run_ros(config_path: str, config: PlannerConfig, store_path: Path, args: arg
                     "-p", f"objectives:=[{','.join(objectives)}]"]
     emulator_cmd += (["-p", f"noise:={str(args.noise).lower()}"] if kind == "redox"
                      else ["-p", f"parameters:=[{','.join(names)}]"])
-    logs = [open(out / "planner_node.log", "w"), open(out / f"{kind}_node.log", "w")]
-    processes = [subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT)
-                 for cmd, log in zip((planner_cmd, emulator_cmd), logs)]
+    logs = {"planner node": open(out / "planner_node.log", "a"),
+            f"{kind} emulator node": open(out / f"{kind}_node.log", "a")}
+    supervisor = Supervisor()
     best_value = BestSoFar(config)
     store = None
     try:
+        processes = [supervisor.start(name, cmd, env, stdout=log, stderr=subprocess.STDOUT)
+                     for (name, log), cmd in zip(logs.items(), (planner_cmd, emulator_cmd))]
         done, last_change = -1, time.monotonic()
         while True:
             if store is None and store_path.is_file():
@@ -113,24 +102,27 @@ def run_ros(config_path: str, config: PlannerConfig, store_path: Path, args: arg
                 return
             if count != done:
                 done, last_change = count, time.monotonic()
-            for process, log in zip(processes, logs):
+            for process, (name, log) in zip(processes, logs.items()):
                 if process.poll() is not None:
-                    raise GryffinRosError(f"{Path(log.name).stem} exited with code {process.returncode}; see "
-                                          f"{log.name}")
+                    raise GryffinRosError(f"the {name} exited with code {process.returncode}; see {log.name}")
             if time.monotonic() - last_change > STALL_SECONDS:
                 raise GryffinRosError(f"no new observation for {STALL_SECONDS:.0f} s; see the logs in {out}")
             time.sleep(0.1)
     finally:
-        stop(processes, env)
-        for log in logs:
-            log.close()
         if store is not None:
             store.close()
+        ended = supervisor.stop()
+        for log in logs.values():
+            log.close()
+        clean_shared_memory(env)
+        for end in ended:  # an operator sees how each node ended; one that had to be forced is named
+            print(f"{end}" + ("" if end.clean else f"; see {logs[end.name].name}"), file=sys.stderr, flush=True)
 
 
 def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespace, out: Path,
-                 seed: int | None) -> tuple[int, dict[str, float] | None, bool]:
-    """One campaign into `out`: store, CSV, PNG. Returns (experiments, best objectives, interrupted)."""
+                 seed: int | None) -> tuple[int, dict[str, float] | None, int]:
+    """One campaign into `out`: store, CSV, PNG. Returns (experiments, best objectives, 0 or the exit code of the
+    signal that stopped it: 130 for Ctrl-C, 143 for SIGTERM, 129 for SIGHUP)."""
     out.mkdir(parents=True, exist_ok=True)
     store_path = out / "campaign.sqlite"
     CampaignStore(store_path, config.raw, config.hash).close()  # created (or checked) before anything starts
@@ -140,14 +132,14 @@ def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespa
         board = start(store_path, "127.0.0.1", args.dashboard, Path(config_path).parent)
         print(f"dashboard: {board.url}", flush=True)
     progress = Progress(args.budget)
-    interrupted = False
+    interrupted = 0
     try:
         if args.no_ros:
             run_local(config_path, config, store_path, args, progress, seed)
         else:
             run_ros(config_path, config, store_path, args, progress, out, seed)
-    except KeyboardInterrupt:
-        interrupted = True
+    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM or SIGHUP (signals_as_interrupt)
+        interrupted = exc.exit_code if isinstance(exc, Interrupted) else 130
     finally:
         progress.close()
         store = CampaignStore.open_existing(store_path)
@@ -171,8 +163,13 @@ def campaign(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path.cwd() / f"campaign-{config.name}-{time.strftime('%Y%m%d-%H%M%S')}"
     transport = "Python API" if args.no_ros else "planner node + emulator node over ROS 2"
     print(f"campaign '{config.name}' ({config_path}), budget {args.budget}, {transport}; output {out}")
+    with signals_as_interrupt():
+        return run_campaigns(config_path, config, args, out)
+
+
+def run_campaigns(config_path: str, config: PlannerConfig, args: argparse.Namespace, out: Path) -> int:
     if args.seeds is None:
-        return 130 if run_campaign(config_path, config, args, out, args.seed)[2] else 0
+        return run_campaign(config_path, config, args, out, args.seed)[2]
     first = args.seed or 0
     rows = ["| seed | experiments | best |", "|---|---|---|"]
     for seed in range(first, first + args.seeds):
@@ -184,4 +181,4 @@ def campaign(args: argparse.Namespace) -> int:
             break
     (out / "summary.md").write_text(f"campaign '{config.name}', budget {args.budget}\n\n" + "\n".join(rows) + "\n")
     print("\n".join(rows))
-    return 130 if interrupted else 0
+    return interrupted

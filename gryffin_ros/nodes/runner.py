@@ -1,5 +1,6 @@
 """Start-up and shutdown shared by the nodes: loopback environment, a clear message and exit code 2 when the node
-cannot start, a clean shutdown on Ctrl-C or SIGTERM.
+cannot start, a clean shutdown on Ctrl-C, SIGTERM or SIGHUP, or when the supervisor that started the node is gone
+(`supervisor.watch_lifeline`).
 
 rclpy's own signal handler would invalidate the context at once, while callbacks may still be running in the
 executor's threads (their publishes then fail: "publisher's context is invalid"). Here a signal only ends the spin
@@ -27,6 +28,7 @@ from rclpy.signals import SignalHandlerOptions
 
 from ..planner import GryffinRosError
 from ..rosenv import apply_to_this_process
+from .supervisor import watch_lifeline
 
 # How often the spin loop looks at the stop flag (the longest a signal waits to be noticed).
 STOP_POLL_S = 0.1
@@ -92,7 +94,8 @@ def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None
             raise KeyboardInterrupt
         stop.set()
 
-    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    watch_lifeline(stop.set)  # started by a Supervisor: stop when it is gone, however it ended
     try:
         try:
             node = make_node()

@@ -13,10 +13,10 @@ from .conftest import add_one
 CHROMIUM = shutil.which("chromium")
 CHROMEDRIVER = shutil.which("chromedriver")
 webdriver = pytest.importorskip("selenium.webdriver", reason="selenium is not installed (make installs it)")
-pytestmark = pytest.mark.skipif(
+pytestmark = [pytest.mark.browser, pytest.mark.skipif(
     CHROMIUM is None or CHROMEDRIVER is None,
     reason="Debian's chromium and chromium-driver are not installed (as root: apt-get install chromium "
-           "chromium-driver; .ci/run does)")
+           "chromium-driver; .ci/run does)")]
 # Deadlines only catch hangs: the page polls every 2 s and draws in well under a second here.
 HANG_S = 120
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import os
-import signal
 import subprocess
 import sys
 import threading
@@ -19,6 +18,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from gryffin_ros.nodes.supervisor import Supervisor
 from gryffin_ros.rosenv import ros_environment
 
 os.environ.update(ros_environment())  # before rclpy is initialized in this process
@@ -166,8 +166,12 @@ class PlannerProcess:
             args += ["-p", f"{key}:={str(value).lower() if isinstance(value, bool) else value}"]
         self.log_path = tmp_path / f"planner-{self.config_path.stem}.log"
         self.log = open(self.log_path, "a")
-        self.process = subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.planner_node", *args],
-                                        env=node_env(tmp_path), stdout=self.log, stderr=subprocess.STDOUT)
+        # owned by a supervisor: stopped in order at the end of the test, and gone with the test process if that
+        # is killed (a node finishes an ask in flight before it exits, hence the long stop timeout)
+        self.supervisor = Supervisor(stop_timeout_s=HANG_S)
+        self.process = self.supervisor.start("planner node", [sys.executable, "-m", "gryffin_ros.nodes.planner_node",
+                                                              *args], node_env(tmp_path), stdout=self.log,
+                                             stderr=subprocess.STDOUT)
 
     def output(self) -> str:
         if not self.log.closed:
@@ -175,15 +179,24 @@ class PlannerProcess:
         return self.log_path.read_text()
 
     def stop(self) -> int:
-        if self.process.poll() is None:
-            self.process.send_signal(signal.SIGINT)
-            try:
-                self.process.wait(timeout=HANG_S)  # a node finishes an ask in flight before it exits
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait()
+        self.supervisor.stop()
         self.log.close()
         return self.process.returncode
+
+
+@pytest.fixture
+def supervisor():
+    """Starts the test's other node processes (emulators); stops them at its end, and they leave with the test
+    process if that is killed."""
+    with Supervisor() as owner:
+        yield owner
+
+
+def start_emulator(supervisor: Supervisor, tmp_path: Path, *args: str) -> subprocess.Popen:
+    """A flow-reactor emulator node with these `--ros-args`, its output discarded."""
+    return supervisor.start("emulator node", [sys.executable, "-m", "gryffin_ros.nodes.emulator_node", "flow_reactor",
+                                              "--ros-args", *args], node_env(tmp_path), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
 
 
 @pytest.fixture

@@ -4,14 +4,12 @@ the shared memory of the killed nodes is cleaned afterwards."""
 
 import random
 import sqlite3
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 from tests import fastdds_shm
 
-from .conftest import HANG_S, node_env
+from .conftest import HANG_S, start_emulator
 
 BUDGET = 24
 KILLS = 5
@@ -34,14 +32,12 @@ def wait_for_observations(path: Path, count: int) -> None:
         time.sleep(0.2)
 
 
-def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, start_planner, tmp_path):
-    fastdds_shm.clean()  # what crashed runs left before this test is not this test's business
-    before = fastdds_shm.lock_files()
+def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, start_planner, supervisor,
+                                                                        tmp_path):
+    held: set[str] = set()  # the shared memory of this test's nodes (a parallel worker has its own)
     store = tmp_path / "crash.sqlite"
-    emulator = subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.emulator_node", "flow_reactor", "--ros-args",
-                                 "-p", "seed:=3", "-p", "experiment_time_s:=0.05", "-p", "objectives:=[X1_X2]"],
-                                env=node_env(tmp_path),
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    emulator = start_emulator(supervisor, tmp_path, "-p", "seed:=3", "-p", "experiment_time_s:=0.05", "-p",
+                              "objectives:=[X1_X2]")
     rng = random.Random(7)
     acknowledged: set[str] = set()
     try:
@@ -51,6 +47,7 @@ def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, 
             # second more), not in seconds: on a slow machine seconds alone would land every kill in the first ask
             wait_for_observations(store, len(stored(store)[0]) + rng.randint(0, 2))
             time.sleep(rng.uniform(0.0, 1.0))
+            held |= fastdds_shm.held_by(planner.process.pid)
             planner.process.kill()  # SIGKILL: no shutdown code runs
             planner.process.wait()
             with client.lock:
@@ -60,6 +57,7 @@ def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, 
         with client.lock:
             acknowledged |= {e["experiment_id"] for e in client.events if e["type"] == "observation_accepted"}
     finally:
+        held |= fastdds_shm.held_by(emulator.pid)
         emulator.kill()
         emulator.wait()
     observed, proposed = stored(store)
@@ -70,4 +68,5 @@ def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, 
     status = client.status()
     assert status["n_observations"] >= BUDGET
     fastdds_shm.clean()  # the killed nodes' ports and segments
-    assert not fastdds_shm.zombies(fastdds_shm.lock_files() - before), "shared memory of dead nodes left behind"
+    assert held, "the nodes' shared memory was not found"
+    assert not fastdds_shm.zombies(held), "shared memory of dead nodes left behind"

@@ -3,12 +3,10 @@ thread was free left each thread's malloc arena holding its own large freed bloc
 soak benchmark, benchmarks/soak.py); the node now runs every ask on one thread."""
 
 import sqlite3
-import subprocess
-import sys
 import time
 from pathlib import Path
 
-from .conftest import HANG_S, node_env
+from .conftest import HANG_S, start_emulator
 
 # Growth allowed between the 100th and the 400th experiment. Measured on 2 cores, batches of 10: about +5 MB with
 # the asks on one thread; with the asks on changing threads the same stretch grew by 40-85 MB (soak benchmark and an
@@ -37,12 +35,10 @@ def wait_for(path: Path, count: int) -> None:
         time.sleep(0.1)
 
 
-def test_planner_memory_stays_flat_over_hundreds_of_asks(start_planner, tmp_path):
+def test_planner_memory_stays_flat_over_hundreds_of_asks(start_planner, supervisor, tmp_path):
     store = tmp_path / "memory.sqlite"
     planner = start_planner(storage=str(store), batch_size=10)
-    emulator = subprocess.Popen([sys.executable, "-m", "gryffin_ros.nodes.emulator_node", "flow_reactor", "--ros-args",
-                                 "-p", "seed:=1", "-p", "objectives:=[X1_X2]"], env=node_env(tmp_path),
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    emulator = start_emulator(supervisor, tmp_path, "-p", "seed:=1", "-p", "objectives:=[X1_X2]")
     try:
         wait_for(store, 100)
         early = rss_mb(planner.process.pid)

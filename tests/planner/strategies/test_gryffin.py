@@ -222,6 +222,7 @@ def test_baselines_share_the_interface_and_respect_constraints(strategy, unit_sq
     assert type(planner).from_state(planner.state()).state() == planner.state()
 
 
+@pytest.mark.slow
 def test_constrained_branin_beats_random_search(unit_square_config):
     """Paper constraint, 50 evaluations, 4 seeds: the planner's median best beats random search's."""
     def best_after(strategy, seed, budget=50):

@@ -98,7 +98,7 @@ def assert_valid(specs, checks, params):
         assert check(params), params
 
 
-@settings(max_examples=30, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=20, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(problem=problems(), optimizer=st.sampled_from(["adam", "genetic"]), seed=st.integers(0, 2**31))
 def test_planner_proposals_are_always_feasible_in_bounds_and_typed(problem, optimizer, seed):
     specs, texts, _, _ = problem

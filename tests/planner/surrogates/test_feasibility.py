@@ -65,6 +65,7 @@ def test_every_feasibility_approach_proposes_feasible_points(approach):
         planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
 
 
+@pytest.mark.slow
 def test_a_region_that_always_fails_is_learned_and_avoided():
     """x0 > 0.5 and x1 > 0.5 fails (a quarter of the domain); the planner is not told. Over 60 experiments it must
     propose there far less often than the region's area (uniform sampling: 25 %; measured: about 5 %)."""

@@ -227,7 +227,7 @@ def test_unknown_surrogate_is_refused():
         Planner(config("forest"))
 
 
-@settings(max_examples=12, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=8, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(problem=problems(), surrogate=st.sampled_from(["gp", "auto", "portfolio"]),
        optimizer=st.sampled_from(["adam", "genetic"]),
        seed=st.integers(0, 2**31))
