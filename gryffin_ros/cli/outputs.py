@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..nodes.supervisor import signals_as_interrupt
 from ..planner import Planner
 from ..planner.chimera import hierarchy, tolerance_line
 from ..planner.config import PlannerConfig
@@ -72,17 +73,20 @@ def export(args: argparse.Namespace) -> int:
 
 
 def dashboard(args: argparse.Namespace) -> int:
-    """Serve the store's dashboard until Ctrl-C."""
+    """Serve the store's dashboard until Ctrl-C (or SIGTERM, SIGHUP)."""
     from ..dashboard import start
     server = start(args.store, args.host, args.port, Path(args.config).resolve().parent if args.config else None)
     print(f"dashboard of {args.store}: {server.url}  (Ctrl-C to stop)", flush=True)
     if not server.loopback:
         print(f"warning: {args.host} makes the page reachable from other machines, without authentication",
               file=sys.stderr)
-    try:
-        threading.Event().wait()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        server.close()
+    # Ctrl-C, SIGTERM and SIGHUP stop it, set here rather than left to Python's default: a process started in the
+    # background of a script inherits SIGINT ignored, and would not stop on Ctrl-C
+    with signals_as_interrupt():
+        try:
+            threading.Event().wait()
+        except KeyboardInterrupt:
+            pass
+        finally:
+            server.close()
     return 0
