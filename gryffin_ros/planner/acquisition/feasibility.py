@@ -16,9 +16,9 @@ from collections.abc import Mapping
 import numpy as np
 import torch
 
-from ..acquisition.kernel import Acquisition
 from ..space import SearchSpace
-from .kernel_density import KernelDensity
+from ..surrogates.kernel_density import KernelDensity
+from .kernel import Acquisition
 
 APPROACHES = ("fwa", "fia", "fca")
 FCA_MIN_PASSING = 0.1

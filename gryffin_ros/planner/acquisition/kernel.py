@@ -22,6 +22,8 @@ CHUNK_ELEMENTS = 2_000_000
 
 
 class Acquisition:
+    log_scale = False  # Gryffin's acquisition values, not a logarithm (AcquisitionFunction)
+
     def __init__(self, density: KernelDensity, strategy: float):
         self.density = density
         self.strategy = float(strategy)

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import torch
 
+from ..acquisition.feasibility import FeasibilityModel, combine
 from ..acquisition.kernel import Acquisition
 from ..config import PlannerConfig
 from ..constraints.sampling import perturb, rejection_sample, spread_seeds
@@ -19,14 +20,14 @@ from ..optimizers import AcquisitionOptimizer, make_optimizer
 from ..reporting import report
 from ..surrogates.choice import SurrogateChoice
 from ..surrogates.descriptors import LearnedDescriptors, learn_many
-from ..surrogates.feasibility import FeasibilityModel, combine
 from ..surrogates.kernel_density import KernelDensity
 from .base import BasePlanner
 from .feasible import SPREAD_SEEDS
 from .selection import apart, batch_spacing, select
 
-if TYPE_CHECKING:  # the GP module (and BoTorch, ~0.4 s to import) is loaded only by planners that use it
-    from ..surrogates.gaussian_process import GaussianProcess, GPAcquisition
+if TYPE_CHECKING:  # the GP modules (and BoTorch, ~0.4 s to import) are loaded only by planners that use a GP
+    from ..acquisition import AcquisitionFunction
+    from ..surrogates.gaussian_process import GaussianProcess
 
 # general.kernel_width = spacing: continuous kernels of precision SPACING_FACTOR * rho^(2/C), a quarter of the typical
 # spacing of the data wide (measured on the paper's continuous benchmarks: factors 4-32 all beat Gryffin's 12 rho^2,
@@ -223,7 +224,7 @@ class Planner(BasePlanner):
             strategies.append(s)
         return np.array(points), strategies, meta
 
-    def _candidates(self, acquisition: Acquisition | GPAcquisition, start: np.ndarray, exhaustive: bool,
+    def _candidates(self, acquisition: AcquisitionFunction, start: np.ndarray, exhaustive: bool,
                     optimizer: AcquisitionOptimizer, rng: np.random.Generator,
                     feasibility: FeasibilityModel | None) -> tuple[np.ndarray, np.ndarray]:
         """Optimized feasible candidates and their scores (acquisition combined with P(feasible) once experiments
@@ -237,7 +238,7 @@ class Planner(BasePlanner):
         if feasibility is not None:
             general = self.config.general
             probability = feasibility.probability(candidates)
-            if general.feas_approach == "fwa" and getattr(acquisition, "log_scale", False):
+            if general.feas_approach == "fwa" and acquisition.log_scale:
                 # the GP's EI weighted by P(feasible) itself (constrained EI, Gardner et al. 2014), in log space: its
                 # min-max rescaled value is nearly flat where EI is small, and failing regions kept their weight
                 alpha = alpha - np.log(np.maximum(probability, MIN_PROBABILITY))
@@ -258,15 +259,16 @@ class Planner(BasePlanner):
             else observed[:0]
         gp.believe(failed, incumbent=False)
         gp.believe(chosen)
+        from ..acquisition.gp import GPAcquisition  # BoTorch: loaded by the planners that use a GP
         optimizer = self.optimizer()
-        candidates, alpha = self._candidates(gp.acquisition(), start, exhaustive, optimizer, rng, feasibility)
+        candidates, alpha = self._candidates(GPAcquisition(gp), start, exhaustive, optimizer, rng, feasibility)
         points = []
         spacing = batch_spacing(self.space, n, self.feasible_fraction.value)
         for i in range(n):
             report("selecting", i / n, i)
             if i:  # the believed points changed the acquisition: the optimized candidates are scored again (an
                 # optimization per point made a plate of 96 take a minute)
-                candidates, alpha = self._candidates(gp.acquisition(), candidates, True, optimizer, rng, feasibility)
+                candidates, alpha = self._candidates(GPAcquisition(gp), candidates, True, optimizer, rng, feasibility)
                 alpha = apart(self.space, candidates, alpha, np.array(points), spacing)
             x = self._pick(candidates, alpha, observed, chosen, rng, diverse=False)
             chosen = np.concatenate([chosen, x[None]])

@@ -1,6 +1,7 @@
 """The Gaussian-process surrogate (general.surrogate = gp), built on BoTorch/GPyTorch: an exact GP with a Matern-5/2
 ARD kernel on normalized inputs, standardized outputs and hyperparameters by marginal likelihood, and its log expected
-improvement as an acquisition that the planner's constrained optimizers (Adam/Hill, genetic) minimize like Gryffin's.
+improvement as an acquisition (`acquisition.gp.GPAcquisition`) that the planner's constrained optimizers (Adam/Hill,
+genetic) minimize like Gryffin's.
 
 Inputs: continuous dims as they are inside the planner ([0, 1]; periodic ones as a point on a circle), discrete dims
 at their ordinal positions in [0, 1], categorical dims through their descriptors (static or learned, each column
@@ -40,7 +41,6 @@ FIT_MAX, FIT_BEST = 300, 100
 COND_MAX, COND_BEST = 1000, 300
 
 try:
-    from botorch.acquisition.analytic import _log_ei_helper as log_ei_helper  # log(phi(u) + u Phi(u)), stable
     from botorch.exceptions import ModelFittingError
     from botorch.fit import fit_gpytorch_mll
     from botorch.models import MixedSingleTaskGP, SingleTaskGP
@@ -215,9 +215,6 @@ class GaussianProcess:
             self._posterior = Posterior(self.model)
         return self._posterior
 
-    def acquisition(self) -> GPAcquisition:
-        return GPAcquisition(self)
-
 
 class Posterior:
     """The fitted GP's posterior in standardized output units, computed from one kernel matrix between candidates
@@ -267,43 +264,6 @@ class Posterior:
                 if incumbent:
                     self.best = min(self.best, float(mean))
                 self._update_weights()
-
-
-class GPAcquisition:
-    """alpha(x) = -log EI(x) of the GP against the best observation (standardized units: a constant shift of alpha,
-    which the planner's scores never see): the same interface as the kernel acquisition (`evaluate`,
-    `value_and_grad`), so Adam/Hill and the genetic optimizer minimize it under the known constraints."""
-
-    log_scale = True  # alpha is -log EI: weighting EI by P(feasible) is adding -log P
-
-    def __init__(self, gp: GaussianProcess):
-        self.space = gp.space
-        self.features = gp.features
-        self.posterior = gp.posterior
-
-    def _alpha(self, xc: torch.Tensor, xf: torch.Tensor) -> torch.Tensor:
-        mean, sigma = self.posterior.mean_and_sigma(self.features(xc, xf))
-        return -(log_ei_helper((self.posterior.best - mean) / sigma) + sigma.log())
-
-    def evaluate(self, X: np.ndarray) -> np.ndarray:
-        """alpha at (M, D) internal points."""
-        xc, xf = split(self.space, X)
-        with torch.no_grad():
-            return np.concatenate([self._alpha(xc[i:i + CHUNK], xf[i:i + CHUNK]).numpy()
-                                   for i in range(0, len(X), CHUNK)]) if len(X) else np.empty(0)
-
-    def value_and_grad(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """alpha (M,) and its gradient w.r.t. the continuous internal coordinates (M, C), by autograd."""
-        xc, xf = split(self.space, X)
-        alpha, grad = np.empty(len(X)), np.zeros(xc.shape)
-        for i in range(0, len(X), CHUNK):
-            leaf = xc[i:i + CHUNK].clone().requires_grad_(bool(xc.shape[1]))
-            value = self._alpha(leaf, xf[i:i + CHUNK])
-            if xc.shape[1]:
-                (g,) = torch.autograd.grad(value.sum(), leaf)
-                grad[i:i + CHUNK] = g.numpy()
-            alpha[i:i + CHUNK] = value.detach().numpy()
-        return alpha, grad
 
 
 def rank_correlation(a: np.ndarray, b: np.ndarray) -> float:

@@ -6,7 +6,7 @@ import pytest
 import torch
 
 from gryffin_ros.planner import Planner
-from gryffin_ros.planner.surrogates.feasibility import FeasibilityModel, combine
+from gryffin_ros.planner.acquisition.feasibility import FeasibilityModel, combine
 
 SQUARE = {"parameters": [{"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0},
                          {"name": "x1", "type": "continuous", "low": 0.0, "high": 1.0}],
