@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from setuptools import find_packages, setup
+from setuptools import find_namespace_packages, setup
 
 PACKAGE = "gryffin_ros"
 
@@ -14,7 +14,9 @@ setup(
     long_description_content_type="text/markdown",
     license="Apache-2.0",
     python_requires=">=3.10",
-    packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
+    # namespace packages too: the data folders (dashboard/static, emulators/data, resources) are packages of the
+    # wheel, which setuptools wants listed
+    packages=find_namespace_packages(include=[PACKAGE, f"{PACKAGE}.*"], exclude=["*.__pycache__"]),
     include_package_data=True,
     package_data={PACKAGE: ["resources/*.xml", "emulators/data/*", "dashboard/static/*"]},
     data_files=[

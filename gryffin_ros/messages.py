@@ -21,7 +21,21 @@ MAX_MESSAGE_BYTES = 1 << 20
 
 
 class MessageError(GryffinRosError):
-    """A payload is not valid JSON or does not follow its schema."""
+    """A payload is not valid JSON or does not follow its schema. `experiment_id`: the id the refused message gives
+    (one observation, or a list of one), so that the refusal names it; None when it gives none."""
+
+    def __init__(self, reason: str, experiment_id: str | None = None) -> None:
+        super().__init__(reason)
+        self.experiment_id = experiment_id
+
+
+def experiment_id_in(document: Any) -> str | None:
+    """The experiment id a parsed but invalid document names, if it names exactly one."""
+    if isinstance(document, list) and len(document) == 1:
+        document = document[0]
+    if isinstance(document, dict) and isinstance(document.get("experiment_id"), str):
+        return document["experiment_id"] or None
+    return None
 
 
 @cache
@@ -50,6 +64,8 @@ def parse(name: str, text: str, max_bytes: int = MAX_MESSAGE_BYTES) -> Any:
         check(name, document)
     except RecursionError:
         raise MessageError("JSON nested too deeply") from None
+    except MessageError as exc:
+        raise MessageError(str(exc), experiment_id_in(document)) from None
     return document
 
 

@@ -118,9 +118,19 @@ class CampaignStore:
         except sqlite3.DatabaseError as exc:
             raise StoreError(f"cannot open campaign store '{self.path}': {exc}") from None
         if stored is not None and stored != config_hash:
+            try:
+                changes = config_differences(json.loads(self.get_meta("config") or "{}"), config)
+            except (ValueError, TypeError):
+                changes = []
+            shown = "; ".join(changes[:MAX_DIFFERENCES_SHOWN]) + (
+                f"; and {len(changes) - MAX_DIFFERENCES_SHOWN} more" if len(changes) > MAX_DIFFERENCES_SHOWN else "")
             raise StoreError(
-                f"campaign store '{self.path}' belongs to a different config (stored hash {stored[:12]}, this config "
-                f"{config_hash[:12]}); use another storage file, or the config it was started with")
+                f"campaign store '{self.path}' belongs to a different config"
+                + (f": {shown}" if changes else f" (stored hash {stored[:12]}, this config {config_hash[:12]})")
+                + ". Start it with the config it was started with, or give the new config a new storage file; to carry "
+                "the results over, export them (gryffin-ros export STORE --json FILE) and report them to the new "
+                "campaign (Campaign(..., accept_unsolicited=True).observe, or Planner.tell): each is checked against "
+                "the new config")
 
     @classmethod
     def open_existing(cls, path: str | Path) -> CampaignStore:
@@ -323,3 +333,34 @@ class CampaignStore:
         }
         Path(path).write_text(json.dumps(document, indent=2))
         return len(document["observations"])
+
+
+MAX_DIFFERENCES_SHOWN = 5
+
+
+def config_differences(stored: Any, given: Any, where: str = "") -> list[str]:
+    """What differs between two configs, as `path: stored -> given` lines (lists of parameters, objectives and
+    constraints are compared entry by entry, a parameter or objective found by its name)."""
+    if isinstance(stored, dict) and isinstance(given, dict):
+        out = []
+        for key in list(stored) + [k for k in given if k not in stored]:
+            path = f"{where}.{key}" if where else str(key)
+            if key not in given:
+                out.append(f"{path} removed (was {stored[key]!r})")
+            elif key not in stored:
+                out.append(f"{path} added ({given[key]!r})")
+            else:
+                out += config_differences(stored[key], given[key], path)
+        return out
+    if isinstance(stored, list) and isinstance(given, list):
+        named = all(isinstance(e, dict) and "name" in e for e in stored + given)
+        if named:
+            old, new = {e["name"]: e for e in stored}, {e["name"]: e for e in given}
+            return config_differences(old, new, where) + (
+                [f"{where}: order changed"] if list(old) != list(new) and set(old) == set(new) else [])
+        out = [line for i, (a, b) in enumerate(zip(stored, given)) if a != b
+               for line in config_differences(a, b, f"{where}[{i}]")]
+        if len(stored) != len(given):
+            out.append(f"{where}: {len(stored)} entries -> {len(given)}")
+        return out
+    return [] if stored == given else [f"{where}: {stored!r} -> {given!r}"]

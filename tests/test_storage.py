@@ -49,9 +49,21 @@ def test_duplicate_experiment_is_refused(tmp_path):
 
 
 def test_another_config_is_refused(tmp_path):
-    CampaignStore(tmp_path / "c.sqlite", CONFIG, "h1")
+    CampaignStore(tmp_path / "c.sqlite", CONFIG, "h1").close()
     with pytest.raises(StoreError, match="belongs to a different config"):
         CampaignStore(tmp_path / "c.sqlite", CONFIG, "h2")
+
+
+def test_a_changed_config_is_refused_saying_what_changed_and_how_to_carry_the_results_over(tmp_path):
+    CampaignStore(tmp_path / "c.sqlite", CONFIG, "h1").close()
+    changed = json.loads(json.dumps(CONFIG))
+    changed["parameters"][0]["high"] = 2.0
+    changed["general"] = {"batches": 2}
+    with pytest.raises(StoreError) as refused:
+        CampaignStore(tmp_path / "c.sqlite", changed, "h2")
+    message = str(refused.value)
+    assert "parameters.x.high: 1 -> 2.0" in message and "general added" in message
+    assert "gryffin-ros export" in message and "accept_unsolicited" in message
 
 
 def test_export_csv_and_json(tmp_path):

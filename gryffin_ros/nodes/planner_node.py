@@ -71,7 +71,7 @@ class StartupError(GryffinRosError):
 
 
 class Deactivated(Cancelled):
-    """The node left the active state while a recommendation ran."""
+    """The node left the active state, or began to shut down, while a recommendation ran."""
 
 
 def check_parameter(name: str, value: Any) -> str | None:
@@ -260,8 +260,18 @@ class PlannerNode(LifecycleNode):
             self.campaign = None
 
     def begin_shutdown(self) -> None:
-        """Stop publishing and auto-proposing (observations arriving meanwhile are still stored, until close)."""
-        self._closing = True
+        """Stop publishing and auto-proposing (observations arriving meanwhile are still stored, until close), and
+        stop the running recommendations at their next checkpoint: their goals are aborted with the reason, while
+        the executor still spins to deliver it (`settled` says when they are done)."""
+        with self._lock:
+            self._closing = True
+            for stop in self._running:
+                stop.set()
+
+    def settled(self) -> bool:
+        """No recommendation is running (each stopped one has handed its goal its result)."""
+        with self._lock:
+            return not self._running
 
     def close(self) -> None:
         """Stop a running recommendation and release the campaign, after observations being stored are done."""
@@ -421,8 +431,8 @@ class PlannerNode(LifecycleNode):
         try:
             items = messages.observation_items(
                 messages.parse("observation", msg.data, self.p["max_message_bytes"]))
-        except GryffinRosError as exc:
-            self._refuse(str(exc), msg.data)
+        except GryffinRosError as exc:  # the id, when the refused message names one (schema errors)
+            self._refuse(str(exc), msg.data, getattr(exc, "experiment_id", None))
             return
         except Exception as exc:  # whatever a sender manages to trigger, the node stays up and says so
             self.get_logger().error(f"internal error parsing an observation message: {exc!r}")
@@ -484,6 +494,8 @@ class PlannerNode(LifecycleNode):
         as GryffinRosError."""
         stop = threading.Event()
         with self._lock:
+            if self._closing:
+                raise Deactivated(self._stopped_reason())
             if not self._active:
                 raise GryffinRosError(f"the planner is not active (lifecycle state {self.lifecycle_state()})")
             self._running.add(stop)
@@ -492,7 +504,7 @@ class PlannerNode(LifecycleNode):
 
         def progress(stage: str, fraction: float, ready: int) -> None:
             if stop.is_set():
-                raise Deactivated("the planner was deactivated while recommending; nothing was proposed")
+                raise Deactivated(self._stopped_reason())
             if cancelled():
                 raise Cancelled("canceled by the client; nothing was proposed")
             if not reported[0] and stage != "waiting":
@@ -528,9 +540,13 @@ class PlannerNode(LifecycleNode):
         self._publish_status()
         return proposals
 
-    @staticmethod
-    def _await(future: futures.Future, stop: threading.Event, feedback: Callable[[str, float, int], None] | None,
-               cancelled: Callable[[], bool]) -> list[Proposal]:
+    def _stopped_reason(self) -> str:
+        if self._closing:
+            return "the planner is shutting down; nothing was proposed (ask again when it is back)"
+        return "the planner was deactivated while recommending; nothing was proposed"
+
+    def _await(self, future: futures.Future, stop: threading.Event,
+               feedback: Callable[[str, float, int], None] | None, cancelled: Callable[[], bool]) -> list[Proposal]:
         """The result of an ask queued on the planner thread; while it waits behind another one it reports
         "waiting" and can be stopped before it starts."""
         while True:
@@ -540,7 +556,7 @@ class PlannerNode(LifecycleNode):
                 if future.running():
                     continue
                 if stop.is_set() and future.cancel():
-                    raise Deactivated("the planner was deactivated while recommending; nothing was proposed") from None
+                    raise Deactivated(self._stopped_reason()) from None
                 if cancelled() and future.cancel():
                     raise Cancelled("canceled by the client; nothing was proposed") from None
                 if feedback is not None:
@@ -570,7 +586,7 @@ class PlannerNode(LifecycleNode):
         return response
 
     def _on_goal(self, goal: Recommend.Goal) -> GoalResponse:
-        return GoalResponse.ACCEPT if self._active else GoalResponse.REJECT
+        return GoalResponse.ACCEPT if self._active and not self._closing else GoalResponse.REJECT
 
     def _execute_recommend(self, goal_handle) -> Recommend.Result:
         count = goal_handle.request.count or self.p["batch_size"]

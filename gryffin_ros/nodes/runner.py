@@ -15,6 +15,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -32,6 +33,10 @@ from .supervisor import watch_lifeline
 
 # How often the spin loop looks at the stop flag (the longest a signal waits to be noticed).
 STOP_POLL_S = 0.1
+# At shutdown the executor spins on while running work stops (at most DRAIN_S; an ask stops at its next checkpoint,
+# well under a second), then DRAIN_AFTER_S more so that the results of aborted goals reach their clients.
+DRAIN_S = 3.0
+DRAIN_AFTER_S = 0.3
 _TYPE_NAMES = {bool: "true or false", int: "an integer", float: "a number", str: "a string", list: "a list"}
 
 
@@ -78,6 +83,18 @@ def environment_line() -> str:
             + (f", ROS_STATIC_PEERS={os.environ['ROS_STATIC_PEERS']}" if os.environ.get("ROS_STATIC_PEERS") else ""))
 
 
+def drain(spinner: Executor, node: Node) -> None:
+    """Spin on, at most DRAIN_S, while the node finishes what it was stopping (a Recommend goal aborted with its
+    reason: its result goes to the client only while the executor spins), and DRAIN_AFTER_S more for the answers."""
+    deadline = time.monotonic() + DRAIN_S
+    settled = getattr(node, "settled", lambda: True)
+    while not settled() and time.monotonic() < deadline:
+        spinner.spin_once(timeout_sec=0.05)
+    until = min(deadline, time.monotonic() + DRAIN_AFTER_S)
+    while time.monotonic() < until:
+        spinner.spin_once(timeout_sec=0.05)
+
+
 def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None,
         executor: Callable[[], Executor] = SingleThreadedExecutor,
         on_exit: Callable[[Node], None] | None = None) -> int:
@@ -115,6 +132,7 @@ def run(make_node: Callable[[], Node], label: str, args: list[str] | None = None
         try:
             if hasattr(node, "begin_shutdown"):
                 node.begin_shutdown()
+                drain(spinner, node)
             spinner.shutdown()
             if on_exit is not None:
                 on_exit(node)  # may wait for a running optimization to write its results

@@ -48,6 +48,9 @@ class CategoricalParameter:
     name: str
     options: tuple
     descriptors: np.ndarray | None = field(default=None, compare=False)
+    # with `descriptor_names`: descriptor name -> option -> its value as given (unscaled), for constraints such as
+    # `T < boiling_point(solvent) - 5`
+    named_descriptors: Mapping[str, Mapping[str, float]] | None = field(default=None, compare=False)
 
     kind = "categorical"
 
@@ -59,7 +62,7 @@ _COMMON_KEYS = {"name", "type", "size", "process_constrained", "units"}
 _ALLOWED_KEYS = {
     "continuous": _COMMON_KEYS | {"low", "high", "periodic", "size"},
     "discrete": _COMMON_KEYS | {"low", "high", "options", "size"},
-    "categorical": _COMMON_KEYS | {"options", "descriptors", "category_details", "size"},
+    "categorical": _COMMON_KEYS | {"options", "descriptors", "category_details", "descriptor_names", "size"},
 }
 
 
@@ -174,4 +177,30 @@ def parameter_from_spec(spec: Mapping[str, Any], position: int) -> Parameter:
         if not isinstance(table, Mapping):
             raise ConfigError(f"{where}: 'descriptors' must map each option to a list of numbers")
         descriptors = _rescale_descriptors(name, options, table)
-    return CategoricalParameter(name, tuple(options), descriptors)
+    named = _named_descriptors(where, spec.get("descriptor_names"), options, table, descriptors)
+    return CategoricalParameter(name, tuple(options), descriptors, named)
+
+
+# names a descriptor cannot take: the functions of the constraint expressions
+RESERVED_NAMES = {"abs", "sqrt", "exp", "log", "min", "max"}
+
+
+def _named_descriptors(where: str, names: Any, options: Sequence[str], table: Mapping | None,
+                       descriptors: np.ndarray | None) -> dict[str, dict[str, float]] | None:
+    """`descriptor_names` (one per descriptor column) -> {name: {option: value as given}}."""
+    if names is None:
+        return None
+    if descriptors is None:
+        raise ConfigError(f"{where}: 'descriptor_names' needs 'descriptors' (a list of numbers per option)")
+    if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) and n.isidentifier() for n in names):
+        raise ConfigError(f"{where}: 'descriptor_names' must be a list of names (letters, digits, _), got {names!r}")
+    if len(names) != descriptors.shape[1]:
+        raise ConfigError(f"{where}: {len(names)} descriptor name(s) for {descriptors.shape[1]} descriptor(s) per "
+                          "option")
+    if len(set(names)) != len(names):
+        raise ConfigError(f"{where}: 'descriptor_names' contains duplicates")
+    reserved = sorted(set(names) & RESERVED_NAMES)
+    if reserved:
+        raise ConfigError(f"{where}: descriptor name(s) {reserved} are functions of the constraint expressions; "
+                          "choose other names")
+    return {n: {o: float(table[o][k]) for o in options} for k, n in enumerate(names)}

@@ -25,6 +25,9 @@ def test_the_view_holds_every_experiment_pending_and_rejected_one(campaign):
     assert data["hierarchy"] == "y >= 0.5, then cost as low as possible"
     expected = best_so_far(Planner(CONFIG, seed=0), campaign.store.observations())
     assert data["best"]["y"] == [None if b is None else b.objectives["y"] for b in expected]
+    # the conditions of the best experiment now head the page
+    assert data["best_experiment"]["experiment_id"] == expected[-1].experiment_id
+    assert data["best_experiment"]["params"] == expected[-1].params
     view.close()
 
 
@@ -57,4 +60,25 @@ def test_a_config_whose_constraints_cannot_be_loaded_still_shows_the_campaign(tm
     view = CampaignView(tmp_path / "c.sqlite", config_dir=tmp_path / "elsewhere")
     data = view.campaign()
     assert data["experiments"] == [] and "feasible.csv" in data["constraint_error"]
+    view.close()
+
+
+def test_shares_by_category_are_the_same_where_the_constraint_ignores_the_category(tmp_path):
+    """x + y < 1.2 does not involve the solvent: along x, each solvent's row is the same estimate (every cell judged
+    at the same completions), and near the truth P(y < 1.2 - x) for y uniform on [0, 1]."""
+    from gryffin_ros.storage import CampaignStore
+    raw = {"name": "shares", "objectives": [{"name": "z", "goal": "max"}], "constraints": ["x + y < 1.2"],
+           "parameters": [{"name": "x", "type": "continuous", "low": 0.0, "high": 1.0},
+                          {"name": "y", "type": "continuous", "low": 0.0, "high": 1.0},
+                          {"name": "solvent", "type": "categorical", "options": ["water", "ethanol", "dmso"]}]}
+    CampaignStore(tmp_path / "c.sqlite", raw, "h").close()
+    view = CampaignView(tmp_path / "c.sqlite")
+    region = view.feasible("x", "solvent")
+    share = np.array(region["share"])  # rows: solvent; columns: x
+    assert (share == share[0]).all()
+    x = np.array(region["x"]["values"])
+    truth = np.clip(1.2 - x, 0.0, 1.0)
+    completions = 16 * GRID * GRID // share.size
+    # a share of n independent draws: 4 standard errors of the worst case p = 0.5 (a cell off by chance: 6e-5)
+    assert np.abs(share[0] - truth).max() < 4 * np.sqrt(0.25 / completions)
     view.close()

@@ -66,6 +66,9 @@ def test_every_bad_observation_gets_a_specific_reason_and_nothing_is_stored(clie
     for (payload, reason), event in zip(bad, events):
         assert event["type"] == "observation_rejected", (payload, event)
         assert reason in event["reason"], (reason, event)
+        # the refusal names the experiment whenever the message does, schema violations included
+        named = payload.get("experiment_id") if isinstance(payload, dict) else None
+        assert event.get("experiment_id") == named, (payload, event)
     assert events[len(bad)]["type"] == "observation_accepted", events[len(bad)]
     assert events[len(bad) + 1]["type"] == "observation_rejected"
     assert "already reported" in events[len(bad) + 1]["reason"]

@@ -5,6 +5,7 @@ namespaces."""
 from __future__ import annotations
 
 import math
+import signal
 import sqlite3
 import subprocess
 import sys
@@ -253,6 +254,26 @@ def test_a_long_recommendation_is_canceled_and_leaves_nothing_pending(lab, start
     assert lab.transition(Transition.TRANSITION_ACTIVATE)
     assert lab.status().n_pending == 1  # the one of `after`, still owed
     assert lab.recommend_now(1).status == 4
+
+
+def test_a_recommendation_running_when_the_node_is_stopped_is_aborted_with_the_reason(lab, start_planner):
+    planner = start_planner(LONG_CONFIG, auto_propose=False)
+    first = lab.recommend_now(2).result.proposals  # a model exists from here on: the next ask takes long
+    lab.wait_matched()
+    for i, proposal in enumerate(first):
+        lab.observations.publish(observation_of(proposal, {"y": float(i)}))
+    lab.observation_events(2)
+    feedback: list = []
+    goal = lab.send_goal(400, feedback)
+    assert goal.accepted
+    wait_until(lambda: any(f.feedback.stage in ("optimizing", "selecting") for f in list(feedback)),
+               "feedback from the optimizer")
+    planner.process.send_signal(signal.SIGINT)  # Ctrl-C, as an operator stops a node
+    outcome = lab.wait(goal.get_result_async(), "the aborted result")
+    assert outcome.status == 6, outcome  # GoalStatus.STATUS_ABORTED
+    assert "shutting down" in outcome.result.error and not outcome.result.proposals
+    assert planner.process.wait(timeout=HANG_S) == 0
+    assert "never retrieved" not in planner.output() and "Traceback" not in planner.output()
 
 
 def test_parameters_are_validated_when_set_and_read_only_ones_refuse(lab, start_planner):

@@ -34,6 +34,7 @@ function render() {
   const failed = d.experiments.filter((e) => e.failed).length;
   $("summary").textContent = `${d.experiments.length} experiments · ${failed} failed · ${d.pending.length} pending · ` +
     `${d.rejected.length} rejected`;
+  $("best-conditions").textContent = bestConditions(d);
   $("hierarchy").textContent = d.hierarchy ? `Best = ${d.hierarchy} (Chimera: a best value of a lower objective can ` +
     "get worse when an experiment first meets a tolerance above it)." : "";
   fillSelect($("objective"), d.objectives.map((o) => o.name));
@@ -43,6 +44,18 @@ function render() {
   drawParams(d);
   drawPair(d).catch(() => { state.pairKey = null; });
   drawTables(d);
+}
+
+function bestConditions(d) {
+  const b = d.best_experiment;
+  if (!b) return "Best conditions so far: none yet (no successful experiment)";
+  const unit = (items, name) => {
+    const item = items.find((i) => i.name === name);
+    return item && item.units ? ` ${item.units}` : "";
+  };
+  const params = Object.entries(b.params).map(([k, v]) => `${k} = ${fmt(v)}${unit(d.parameters, k)}`).join(", ");
+  const results = Object.entries(b.objectives).map(([k, v]) => `${k} ${fmt(v)}${unit(d.objectives, k)}`).join(", ");
+  return `Best conditions so far (experiment ${b.seq}): ${params} → ${results}`;
 }
 
 function fillSelect(select, names, preferred = 0) {
@@ -136,7 +149,8 @@ async function drawPair(d) {
   const traces = [];
   if (state.region) {
     traces.push({ type: "heatmap", x: state.region.x.values, y: state.region.y.values, z: state.region.share,
-      zmin: 0, zmax: 1, colorscale: [[0, "#d9d9d9"], [1, "#ffffff"]], showscale: false, name: "feasible share",
+      zmin: 0, zmax: 1, colorscale: [[0, "#ffffff"], [1, "#a8d8a0"]], name: "feasible share",
+      showscale: true, colorbar: { title: { text: "feasible share" }, thickness: 12, len: 0.8 },
       hovertemplate: "feasible share %{z}<extra></extra>" });
   }
   const ok = d.experiments.filter((e) => !e.failed), bad = d.experiments.filter((e) => e.failed);

@@ -53,6 +53,7 @@ class Expression:
             raise ConfigError(f"a constraint expression must be a non-empty string, got {text!r}")
         self.text = text
         self._names = set(names)
+        self._parameters = dict(parameters or {})
         try:
             tree = ast.parse(text.strip(), mode="eval")
         except SyntaxError as exc:
@@ -148,15 +149,50 @@ class Expression:
         return compare
 
     def _compile_call(self, node: ast.Call) -> Node:
-        if not isinstance(node.func, ast.Name) or node.func.id not in _FUNCTIONS:
-            raise self._reject(node, "calling anything but abs, min, max, sqrt, exp, log")
         if node.keywords:
             raise self._reject(node, "keyword arguments")
+        if isinstance(node.func, ast.Name) and node.func.id not in _FUNCTIONS:
+            return self._compile_descriptor(node)
+        if not isinstance(node.func, ast.Name):
+            raise self._reject(node, "calling anything but abs, min, max, sqrt, exp, log or a named descriptor")
         fn, low, high = _FUNCTIONS[node.func.id]
         if len(node.args) < low or (high is not None and len(node.args) > high):
             raise self._reject(node, f"{node.func.id}() with {len(node.args)} argument(s)")
         args = [self._compile(a) for a in node.args]
         return lambda cols: fn(*[np.asarray(a(cols), dtype=float) for a in args])
+
+
+    def _compile_descriptor(self, node: ast.Call) -> Node:
+        """`name(parameter)`: the named descriptor of a categorical parameter's option (`descriptor_names`), e.g.
+        `boiling_point(solvent)`; looked up per row from the values given in the config."""
+        function = node.func.id
+        categorical = {n: p for n, p in self._parameters.items() if getattr(p, "kind", None) == "categorical"}
+        offered = sorted({d for p in categorical.values() for d in (p.named_descriptors or {})})
+        if (len(node.args) != 1 or not isinstance(node.args[0], ast.Name)
+                or node.args[0].id not in categorical):
+            if function in offered:
+                raise self._reject(node, f"{function}() of anything but one categorical parameter's name")
+            raise self._reject(node, f"calling '{function}'; functions are abs, min, max, sqrt, exp, log and the "
+                                     f"named descriptors of categorical parameters {offered}"
+                                     f"{suggestion(function, offered)}")
+        parameter = categorical[node.args[0].id]
+        table = (parameter.named_descriptors or {}).get(function)
+        if table is None:
+            names = sorted(parameter.named_descriptors or {})
+            raise ConfigError(f"constraint {self.text!r}: parameter '{parameter.name}' has no descriptor named "
+                              f"'{function}'" + (f"; its descriptors are {names}{suggestion(function, names)}" if names
+                                                 else " (give it 'descriptors' and 'descriptor_names')"))
+        self.variables.add(parameter.name)
+        options = list(table)
+        values = np.array([table[o] for o in options], dtype=float)
+
+        def lookup(cols: Columns) -> np.ndarray:
+            column = np.asarray(cols[parameter.name], dtype=object)
+            out = np.full(column.shape, np.nan)
+            for option, value in zip(options, values):
+                out[column == option] = value
+            return out
+        return lookup
 
 
 # ---- linear forms (equalities solved exactly; linear inequalities as half-spaces) ------------------------

@@ -44,7 +44,11 @@ class ObservationReader:
                     raise ObservationError(f"unknown key(s) {sorted(unknown)}; parameters are "
                                            f"{list(self.parameter_names)}, objectives {sorted(names)}")
                 params = {k: item[k] for k in self.parameter_names if k in item}
-                objectives = {o.name: item.get(o.name) for o in self.objectives}
+                absent = sorted(n for n in names if n not in item)
+                if absent:  # not read as a failure: a failed experiment says so, every objective None
+                    raise ObservationError(f"missing objective(s) {absent}; report a failed experiment with every "
+                                           "objective None")
+                objectives = {o.name: item[o.name] for o in self.objectives}
                 experiment_id, meta = item.get("experiment_id"), {}
         else:
             raise ObservationError(f"an observation must be a mapping, got {type(item).__name__}")

@@ -3,7 +3,15 @@
 import numpy as np
 import pytest
 
-from gryffin_ros.planner import ConfigError, ConstraintError, KnownConstraints, NoFeasiblePointError, SearchSpace
+from gryffin_ros.planner import (
+    ConfigError,
+    ConstraintError,
+    KnownConstraints,
+    NoFeasiblePointError,
+    ObservationError,
+    Planner,
+    SearchSpace,
+)
 from gryffin_ros.planner.constraints import estimate_feasible_fraction
 
 SQUARE = SearchSpace.from_config([{"name": "x0", "type": "continuous", "low": 0, "high": 1},
@@ -109,3 +117,48 @@ def test_lookup_plugin_config_errors(tmp_path, options, message):
     with pytest.raises(ConfigError) as info:
         KnownConstraints.build(space, [{"plugin": "lookup", "options": options}])
     assert message in str(info.value)
+
+
+SOLVENTS = {"parameters": [
+    {"name": "T", "type": "continuous", "low": 20.0, "high": 160.0},
+    {"name": "solvent", "type": "categorical", "options": ["water", "ethanol", "toluene"],
+     "descriptors": {"water": [100.0, 1.0], "ethanol": [78.4, 0.79], "toluene": [110.6, 0.87]},
+     "descriptor_names": ["boiling_point", "density"]}],
+    "objectives": [{"name": "y", "goal": "max"}]}
+BOILING = {"water": 100.0, "ethanol": 78.4, "toluene": 110.6}
+
+
+def test_a_constraint_names_a_categorical_descriptor_and_every_proposal_keeps_it():
+    planner = Planner({**SOLVENTS, "constraints": ["T < boiling_point(solvent) - 5"]}, seed=0)
+    for _ in range(4):
+        for proposal in planner.ask(4):
+            p = proposal.params
+            assert p["T"] < BOILING[p["solvent"]] - 5
+            planner.tell({**p, "y": p["T"] / 100.0, "experiment_id": proposal.experiment_id})
+    # the share of the space below each boiling point (T uniform on [20, 160], the solvents equally likely)
+    truth = np.mean([(b - 5 - 20.0) / 140.0 for b in BOILING.values()])
+    fraction = planner.feasible_fraction
+    assert abs(fraction.value - truth) < 4 * fraction.stderr + 1e-9
+    with pytest.raises(ObservationError, match="violate"):
+        planner.tell({"T": 90.0, "solvent": "ethanol", "y": 0.5})
+
+
+@pytest.mark.parametrize("text, message", [
+    ("T < boilng_point(solvent)", "no descriptor named 'boilng_point'.*did you mean 'boiling_point'"),
+    ("T < boiling_point(T)", "boiling_point\\(\\) of anything but one categorical parameter"),
+    ("T < melting_point(solvent)", "its descriptors are \\['boiling_point', 'density'\\]"),
+    ("T < boiling_point(solvent, solvent)", "boiling_point\\(\\) of anything but one categorical parameter"),
+])
+def test_a_misnamed_descriptor_is_refused_naming_the_ones_there_are(text, message):
+    with pytest.raises(ConfigError, match=message):
+        Planner({**SOLVENTS, "constraints": [text]}, seed=0)
+
+
+def test_descriptor_names_are_checked_when_the_config_loads():
+    solvent = SOLVENTS["parameters"][1]
+    for names, message in ((["boiling_point"], "1 descriptor name"), (["bp", "bp"], "duplicates"),
+                           (["max", "density"], "functions of the constraint expressions"),
+                           (["boiling point", "density"], "must be a list of names")):
+        config = {**SOLVENTS, "parameters": [SOLVENTS["parameters"][0], {**solvent, "descriptor_names": names}]}
+        with pytest.raises(ConfigError, match=message):
+            Planner(config, seed=0)

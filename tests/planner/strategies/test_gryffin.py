@@ -234,3 +234,18 @@ def test_constrained_branin_beats_random_search(unit_square_config):
     random = np.median([best_after(Random, s) for s in range(4)])
     assert ours < random
     assert ours < 1.0  # the constrained optimum is 0.3979; random search is at ~1.8 here
+
+
+def test_a_report_missing_an_objective_is_refused_and_a_failure_says_so(unit_square_config):
+    config = {**unit_square_config, "objectives": [{"name": "y", "goal": "min", "tolerance": 0.5},
+                                                   {"name": "cost", "goal": "min"}]}
+    planner = Planner(config, seed=0)
+    (proposal,) = planner.ask()
+    with pytest.raises(ObservationError, match=r"missing objective\(s\) \['cost'\]"):  # as over ROS
+        planner.tell({**proposal.params, "y": 0.3, "experiment_id": proposal.experiment_id})
+    assert planner.observations == [] and planner.best() is None
+    planner.tell({**proposal.params, "y": None, "cost": None, "experiment_id": proposal.experiment_id})  # failed
+    assert planner.observations[0].failed
+    (proposal,) = planner.ask()
+    planner.tell({**proposal.params, "y": 0.3, "cost": 2.0, "experiment_id": proposal.experiment_id})
+    assert planner.best().objectives == {"y": 0.3, "cost": 2.0}
