@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from gryffin_ros.rosenv import ros_environment
+from gryffin_ros.nodes.rosenv import ros_environment
 
 os.environ.update(ros_environment())
 

@@ -31,8 +31,8 @@ import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
+from gryffin_ros.nodes.rosenv import profile_path
 from gryffin_ros.nodes.supervisor import Supervisor
-from gryffin_ros.rosenv import profile_path
 
 PREFIX = "grlab"
 SUBNET = "10.213.7"  # /24 inside the lab only; host k gets SUBNET.(k + 1)

@@ -25,8 +25,8 @@ import threading
 import time
 from pathlib import Path
 
+from gryffin_ros.nodes.rosenv import ros_environment
 from gryffin_ros.paths import share_path
-from gryffin_ros.rosenv import ros_environment
 
 os.environ.update(ros_environment())
 

@@ -71,3 +71,23 @@ def held_by(pid: int) -> set[str]:
         if target.parent == SHM_DIR and LOCK_FILE.match(target.name):
             held.add(target.name)
     return held
+
+
+# RTPS well-known ports (the Fast DDS shared-memory transport uses the same numbers): PB + DG * domain + offset
+PORT_BASE, DOMAIN_GAIN = 7400, 250
+
+
+def of_domain(names: set[str], domain: int) -> set[str]:
+    """Of `names`, the participants' own segments and the ports of `domain`'s range. Other ports a node holds (a
+    shared port below the domain ranges, 7001/7003 as seen here) are shared with the processes of other domains, a
+    parallel test worker's among them, and may be left by them: not this test's to judge."""
+    low = PORT_BASE + DOMAIN_GAIN * domain
+    own = set()
+    for name in names:
+        match = LOCK_FILE.match(name)
+        if not match:
+            continue
+        key = match.group(1)
+        if not key.startswith("port") or low <= int(key[4:]) < low + DOMAIN_GAIN:
+            own.add(name)
+    return own

@@ -7,9 +7,9 @@ import sys
 import pytest
 
 from gryffin_ros.emulators import RedoxEmulator
+from gryffin_ros.nodes.rosenv import ros_environment
 from gryffin_ros.paths import share_path
 from gryffin_ros.planner import Planner
-from gryffin_ros.rosenv import ros_environment
 
 EXAMPLES = share_path("examples")
 BEST_REDOX = {"r1_label": "R1_0", "r3_label": "R3_7", "r4_label": "R4_7", "r5_label": "R5_0"}

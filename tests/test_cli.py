@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from gryffin_ros.rosenv import ros_environment
+from gryffin_ros.nodes.rosenv import ros_environment
 from gryffin_ros.storage import CampaignStore
 
 # Deadlines only catch hangs: many times what a step takes on a busy 2-core machine (the 12-experiment campaign over

@@ -12,11 +12,11 @@ from pathlib import Path
 
 from ..campaign import Campaign
 from ..emulators import FlowReactorEmulator, RedoxEmulator
+from ..nodes.rosenv import ros_environment
 from ..nodes.supervisor import Interrupted, Supervisor, signals_as_interrupt
 from ..paths import share_path
 from ..planner import GryffinRosError
 from ..planner.config import PlannerConfig, load_config
-from ..rosenv import ros_environment
 from ..storage import CampaignStore, StoreError
 from .outputs import plot
 from .progress import BestSoFar, Progress

@@ -28,7 +28,7 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from ..planner import GryffinRosError
-from ..rosenv import apply_to_this_process
+from .rosenv import apply_to_this_process
 from .supervisor import watch_lifeline
 
 # How often the spin loop looks at the stop flag (the longest a signal waits to be noticed).
@@ -88,6 +88,8 @@ def drain(spinner: Executor, node: Node) -> None:
     reason: its result goes to the client only while the executor spins), and DRAIN_AFTER_S more for the answers."""
     deadline = time.monotonic() + DRAIN_S
     settled = getattr(node, "settled", lambda: True)
+    if settled():
+        return  # nothing was running: nothing to deliver
     while not settled() and time.monotonic() < deadline:
         spinner.spin_once(timeout_sec=0.05)
     until = min(deadline, time.monotonic() + DRAIN_AFTER_S)

@@ -18,8 +18,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from gryffin_ros.nodes.rosenv import ros_environment
 from gryffin_ros.nodes.supervisor import Supervisor
-from gryffin_ros.rosenv import ros_environment
 
 os.environ.update(ros_environment())  # before rclpy is initialized in this process
 

@@ -2,6 +2,7 @@
 store. No acknowledged observation is lost, no experiment is proposed twice, the campaign reaches its budget, and
 the shared memory of the killed nodes is cleaned afterwards."""
 
+import os
 import random
 import sqlite3
 import time
@@ -68,5 +69,6 @@ def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, 
     status = client.status()
     assert status["n_observations"] >= BUDGET
     fastdds_shm.clean()  # the killed nodes' ports and segments
+    held = fastdds_shm.of_domain(held, int(os.environ["ROS_DOMAIN_ID"]))
     assert held, "the nodes' shared memory was not found"
     assert not fastdds_shm.zombies(held), "shared memory of dead nodes left behind"

@@ -6,6 +6,7 @@ heard by this test's lab client) is in the store, and a rerun with the same --ou
 from __future__ import annotations
 
 import csv
+import os
 import signal
 import sqlite3
 import subprocess
@@ -62,7 +63,8 @@ def test_a_stop_signal_stops_both_nodes_keeps_every_acknowledged_result_and_a_re
     out = tmp_path / "run"
     campaign = start_campaign(tmp_path, out)
     nodes = nodes_once_running(campaign, client, 3)
-    held = set().union(*(fastdds_shm.held_by(pid) for pid, _ in nodes))  # the nodes' shared memory
+    held = fastdds_shm.of_domain(set().union(*(fastdds_shm.held_by(pid) for pid, _ in nodes)),  # the nodes' own
+                                 int(os.environ["ROS_DOMAIN_ID"]))
     campaign.send_signal(sig)
     output, _ = campaign.communicate(timeout=HANG_S)
     assert campaign.returncode == 128 + sig, output

@@ -222,18 +222,26 @@ def test_a_managed_node_is_configured_and_activated_then_recommends_and_learns(l
     assert lab.state() == "unconfigured"
 
 
-def test_a_long_recommendation_is_canceled_and_leaves_nothing_pending(lab, start_planner):
-    start_planner(LONG_CONFIG, auto_propose=False)
-    first = lab.recommend_now(2).result.proposals  # a model exists from here on
-    lab.wait_matched()
-    for i, proposal in enumerate(first):
-        lab.observations.publish(observation_of(proposal, {"y": float(i)}))
-    lab.observation_events(2)
-    feedback: list = []
+def long_goal_optimizing(lab: TypedLab, feedback: list, learn_first: bool = True):
+    """A Recommend goal of 400 proposals on LONG_CONFIG, once the optimizer reports that it is running; with
+    `learn_first`, two results are reported before it, so that a model exists and the ask takes long."""
+    if learn_first:
+        first = lab.recommend_now(2).result.proposals
+        lab.wait_matched()
+        for i, proposal in enumerate(first):
+            lab.observations.publish(observation_of(proposal, {"y": float(i)}))
+        lab.observation_events(2)
     goal = lab.send_goal(400, feedback)
     assert goal.accepted
     wait_until(lambda: any(f.feedback.stage in ("optimizing", "selecting") for f in list(feedback)),
                "feedback from the optimizer")
+    return goal
+
+
+def test_a_long_recommendation_is_canceled_and_leaves_nothing_pending(lab, start_planner):
+    start_planner(LONG_CONFIG, auto_propose=False)
+    feedback: list = []
+    goal = long_goal_optimizing(lab, feedback)
     lab.wait(goal.cancel_goal_async(), "the cancel response")
     outcome = lab.wait(goal.get_result_async(), "the canceled result")
     assert outcome.status == 5, outcome  # GoalStatus.STATUS_CANCELED
@@ -245,9 +253,7 @@ def test_a_long_recommendation_is_canceled_and_leaves_nothing_pending(lab, start
 
     # a deactivation stops a running recommendation too (aborted, nothing stored), and activation resumes serving
     feedback.clear()
-    goal = lab.send_goal(400, feedback)
-    wait_until(lambda: any(f.feedback.stage in ("optimizing", "selecting") for f in list(feedback)),
-               "feedback from the optimizer")
+    goal = long_goal_optimizing(lab, feedback, learn_first=False)
     assert lab.transition(Transition.TRANSITION_DEACTIVATE)
     outcome = lab.wait(goal.get_result_async(), "the aborted result")
     assert outcome.status == 6 and "deactivated" in outcome.result.error, outcome  # GoalStatus.STATUS_ABORTED
@@ -258,16 +264,7 @@ def test_a_long_recommendation_is_canceled_and_leaves_nothing_pending(lab, start
 
 def test_a_recommendation_running_when_the_node_is_stopped_is_aborted_with_the_reason(lab, start_planner):
     planner = start_planner(LONG_CONFIG, auto_propose=False)
-    first = lab.recommend_now(2).result.proposals  # a model exists from here on: the next ask takes long
-    lab.wait_matched()
-    for i, proposal in enumerate(first):
-        lab.observations.publish(observation_of(proposal, {"y": float(i)}))
-    lab.observation_events(2)
-    feedback: list = []
-    goal = lab.send_goal(400, feedback)
-    assert goal.accepted
-    wait_until(lambda: any(f.feedback.stage in ("optimizing", "selecting") for f in list(feedback)),
-               "feedback from the optimizer")
+    goal = long_goal_optimizing(lab, [])
     planner.process.send_signal(signal.SIGINT)  # Ctrl-C, as an operator stops a node
     outcome = lab.wait(goal.get_result_async(), "the aborted result")
     assert outcome.status == 6, outcome  # GoalStatus.STATUS_ABORTED
