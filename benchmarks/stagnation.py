@@ -22,9 +22,8 @@ from pathlib import Path
 from gryffin_ros.campaign import Campaign
 from gryffin_ros.emulators import FlowReactorEmulator
 from gryffin_ros.paths import share_path
-from gryffin_ros.planner import Planner
 from gryffin_ros.planner.config import load_config
-from gryffin_ros.planner.progress import best_so_far
+from gryffin_ros.planner.merit import best_so_far
 
 CONFIG = share_path("examples") / "flow_reactor.yaml"
 YIELD = 0.9
@@ -47,8 +46,7 @@ def run(seed: int, budget: int, batch: int, milestones: list[int], work: Path) -
                 campaign.observe({"experiment_id": proposal.experiment_id, "params": proposal.params,
                                   "objectives": {"X1_X2": result["X1_X2"], "cost": result["cost"]}})
         observations = campaign.store.observations()
-    judge = Planner(load_config(CONFIG), seed=0)
-    trace = best_so_far(judge, observations)
+    trace = best_so_far(load_config(CONFIG), observations)
     at = {m: trace[m - 1] for m in milestones if m <= len(trace)}
     changes_after = sum(1 for k in range(milestones[0], len(trace))
                         if trace[k] is not None and trace[k] is not trace[k - 1])

@@ -57,3 +57,11 @@ def test_the_import_reader_resolves_relative_imports():
     # gryffin_ros/planner/acquisition/gp.py: "from ..surrogates.gaussian_process import CHUNK, GaussianProcess"
     found = imported_modules(PACKAGE / "planner" / "acquisition" / "gp.py")
     assert "gryffin_ros.planner.surrogates.gaussian_process" in found
+
+
+def test_the_merit_module_is_pure():
+    """Ranking observations needs the objectives alone: no planner, constraints, models or torch."""
+    found = imported_modules(PACKAGE / "planner" / "merit.py")
+    heavy = ("gryffin_ros.planner.strategies", "gryffin_ros.planner.constraints", "gryffin_ros.planner.surrogates",
+             "gryffin_ros.planner.acquisition", "torch", "botorch")
+    assert not [m for m in found if m.startswith(heavy)], found

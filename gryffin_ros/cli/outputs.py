@@ -10,10 +10,9 @@ from pathlib import Path
 import numpy as np
 
 from ..nodes.supervisor import signals_as_interrupt
-from ..planner import Planner
 from ..planner.chimera import hierarchy, tolerance_line
 from ..planner.config import PlannerConfig
-from ..planner.progress import best_so_far
+from ..planner.merit import best_so_far
 from ..storage import CampaignStore
 
 
@@ -27,7 +26,7 @@ def plot(store: CampaignStore, config: PlannerConfig, path: Path) -> None:
     from matplotlib.ticker import MaxNLocator
 
     observations = store.observations()
-    bests = best_so_far(Planner(config, seed=0), observations)
+    bests = best_so_far(config, observations)
     x = np.arange(1, len(observations) + 1)
     several = len(config.objectives) > 1
     fig, axes = plt.subplots(1, len(config.objectives), figsize=(5.2 * len(config.objectives), 4.0), squeeze=False)

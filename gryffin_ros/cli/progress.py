@@ -5,9 +5,9 @@ from __future__ import annotations
 import sys
 import time
 
-from ..planner import Observation, Planner
+from ..planner import Observation
 from ..planner.config import PlannerConfig
-from ..planner.progress import best_of
+from ..planner.merit import best_of
 from ..storage import CampaignStore
 
 
@@ -35,14 +35,14 @@ class Progress:
 
 
 class BestSoFar:
-    """Experiments so far and the objectives of the best one (`planner.progress.best_of`), read from a store that
+    """Experiments so far and the objectives of the best one (`planner.merit.best_of`), read from a store that
     another process may be writing; each call reads only the observations stored since the last one."""
 
     def __init__(self, config: PlannerConfig):
-        self.judge = Planner(config, seed=0)
+        self.config = config
         self.observations: list[Observation] = []
 
     def __call__(self, store: CampaignStore) -> tuple[int, dict[str, float] | None]:
         self.observations += store.observations(skip=len(self.observations))
-        best = best_of(self.judge, self.observations)
+        best = best_of(self.config, self.observations)
         return len(self.observations), None if best is None else best.objectives

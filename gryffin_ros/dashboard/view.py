@@ -1,5 +1,5 @@
 """What the dashboard shows, computed from a campaign store (read-only) and its config: plain JSON-ready data, no
-web code here. The best-so-far traces are `planner.progress.best_so_far` (the campaign's own merit, Chimera
+web code here. The best-so-far traces are `planner.merit.best_so_far` (the campaign's own merit, Chimera
 included); the feasible region is computed from the constraints the planner uses."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 from ..planner import Planner
 from ..planner.chimera import hierarchy, tolerance_line
 from ..planner.config import load_config, units_of
-from ..planner.progress import best_so_far
+from ..planner.merit import best_so_far
 from ..storage import CampaignStore
 
 # The two-parameter view: a grid of GRID x GRID cells (continuous axes; one cell per option of a finite one), each
@@ -42,8 +42,7 @@ class CampaignView:
         raw = self.store.config
         self.raw = raw
         # judging needs only the objectives: it always works, whatever the constraints refer to
-        self.judge = Planner({**raw, "constraints": []}, seed=0)
-        self.config = self.judge.config
+        self.config = load_config({**raw, "constraints": []})
         base = Path(config_dir) if config_dir is not None else self.store_path.resolve().parent
         try:
             self.planner: Planner | None = Planner(load_config(raw, base), seed=0)
@@ -82,7 +81,7 @@ class CampaignView:
                 "strategy": None if proposal is None else proposal.strategy,
                 "surrogate": None if proposal is None else proposal.meta.get("surrogate"),
             })
-        bests = best_so_far(self.judge, observations)
+        bests = best_so_far(self.config, observations)
         last = bests[-1] if bests else None  # the best experiment now: its conditions head the page
         best_experiment = None if last is None else next((
             {"seq": e["seq"], "experiment_id": e["experiment_id"], "params": e["params"],

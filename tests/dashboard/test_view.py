@@ -5,8 +5,8 @@ import json
 import numpy as np
 
 from gryffin_ros.dashboard.view import GRID, CampaignView
-from gryffin_ros.planner import Planner
-from gryffin_ros.planner.progress import best_so_far
+from gryffin_ros.planner.config import load_config
+from gryffin_ros.planner.merit import best_so_far
 
 from .conftest import CONFIG, add_one
 
@@ -23,7 +23,7 @@ def test_the_view_holds_every_experiment_pending_and_rejected_one(campaign):
     assert {p["name"]: p["units"] for p in data["parameters"]} == {"x": "mL", "solvent": ""}
     assert data["tolerances"] == {"y": 0.5, "cost": None}
     assert data["hierarchy"] == "y >= 0.5, then cost as low as possible"
-    expected = best_so_far(Planner(CONFIG, seed=0), campaign.store.observations())
+    expected = best_so_far(load_config(CONFIG), campaign.store.observations())
     assert data["best"]["y"] == [None if b is None else b.objectives["y"] for b in expected]
     # the conditions of the best experiment now head the page
     assert data["best_experiment"]["experiment_id"] == expected[-1].experiment_id

@@ -64,7 +64,7 @@ def test_planner_uses_chimera_for_best_and_merits():
 def test_the_best_kept_as_observations_arrive_is_the_best_of_all_of_them():
     """Planner.best() keeps the successful observations' values as they arrive instead of collecting them from every
     record on each call; whatever the order of arrival and the failures among them, it is the best of all."""
-    from gryffin_ros.planner.progress import best_of
+    from gryffin_ros.planner.merit import best_of
     config = {"parameters": [{"name": "x", "type": "continuous", "low": 0, "high": 1}],
               "objectives": [{"name": "X1_X2", "goal": "max", "tolerance": 0.9, "absolute": True},
                              {"name": "cost", "goal": "min"}]}
@@ -75,8 +75,8 @@ def test_the_best_kept_as_observations_arrive_is_the_best_of_all_of_them():
         rows = [{"x": float(x), "X1_X2": float(y) if rng.random() > 0.2 else None, "cost": float(c)}
                 for x, y, c in zip(rng.random(5), rng.uniform(0.5, 1.0, 5), rng.uniform(0.001, 0.01, 5))]
         planner.tell(rows)
-        assert planner.best() is best_of(planner, planner.observations)
+        assert planner.best() is best_of(planner.config, planner.observations)
     restored = Planner(config, seed=0)
     restored.restore(planner.observations, [], 0, 0)
-    assert restored.best() is best_of(planner, planner.observations)
+    assert restored.best() is best_of(planner.config, planner.observations)
     assert len(planner.successful_values()[0]) == sum(not o.failed for o in planner.observations)

@@ -17,12 +17,12 @@ from typing import Any
 
 import numpy as np
 
-from ..chimera import Chimera
 from ..config import PlannerConfig, load_config
 from ..constraints import FeasibleFraction, KnownConstraints
 from ..constraints.equalities import LinearEqualities
 from ..domain import ConstraintArg, Observation, Proposal
 from ..errors import ConfigError, ObservationError
+from ..merit import merits, objective_matrix
 from .feasible import FeasibleRegion
 from .observations import ObservationReader
 
@@ -199,7 +199,7 @@ class BasePlanner:
         return self._successful, self._values
 
     def _objective_matrix(self, observations: Sequence[Observation]) -> np.ndarray:
-        return np.array([[o.objectives[obj.name] for obj in self.objectives] for o in observations], dtype=float)
+        return objective_matrix(self.objectives, observations)
 
     def merits(self, observations: Sequence[Observation], transform: bool = True) -> np.ndarray:
         """Successful observations -> minimization merits in [0, 1]: one objective rescaled (max goals negated),
@@ -212,16 +212,11 @@ class BasePlanner:
         """`merits` of the (n, objectives) values of successful observations."""
         if len(Y) == 0:
             return np.empty(0)
-        if len(self.objectives) > 1:
-            f = Chimera(self.objectives, self.config.general.softness).merits(Y)
-        else:
-            y = -Y[:, 0] if self.objectives[0].goal == "max" else Y[:, 0]
-            span = y.max() - y.min()
-            f = (y - y.min()) / span if span > 0 else np.zeros_like(y)
+        f = merits(self.objectives, Y, self.config.general.softness)
         return OBJ_TRANSFORMS[self.config.general.obj_transform][0](f) if transform else f
 
     def best(self) -> Observation | None:
-        """The best successful observation so far (None before the first one): `progress.best_of` of every
+        """The best successful observation so far (None before the first one): `merit.best_of` of every
         observation, from the values kept as they arrive."""
         successful, values = self.successful_values()
         return successful[int(np.argmin(self.merits_of_values(values, transform=False)))] if successful else None
