@@ -123,7 +123,9 @@ class NetLab:
         return self.supervisor.processes
 
     def close(self) -> None:
-        self.supervisor.stop()  # what is still running (a campaign normally stops its nodes itself, in order)
+        for end in self.supervisor.stop():  # what is still running (a campaign stops its nodes itself, in order)
+            if end.how != "had exited":
+                print(end, file=sys.stderr, flush=True)
         for ns in reversed(self._made):
             _ip("netns", "del", ns, check=False)
         self._made.clear()

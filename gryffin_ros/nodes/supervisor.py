@@ -98,7 +98,8 @@ class Ended:
 
 
 class Supervisor:
-    """Starts node processes and owns them (module doc). Use as a context manager: leaving the block stops them."""
+    """Starts node processes and owns them (module doc). Use as a context manager: leaving the block stops them and
+    says on stderr how each ended; or call `stop`, which returns that."""
 
     def __init__(self, stop_timeout_s: float = 10.0, kill_timeout_s: float = 5.0) -> None:
         self.stop_timeout_s = stop_timeout_s
@@ -133,10 +134,6 @@ class Supervisor:
     def processes(self) -> list[subprocess.Popen]:
         with self._lock:
             return [process for _, process, _ in self._children]
-
-    def names(self) -> dict[int, str]:
-        with self._lock:
-            return {process.pid: name for name, process, _ in self._children}
 
     def stop(self) -> list[Ended]:
         """Stop every process still running (SIGINT to all, then SIGTERM to those still running after
@@ -181,7 +178,8 @@ class Supervisor:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        self.stop()
+        for end in self.stop():  # said on stderr: how each process this block started ended
+            print(end, file=sys.stderr, flush=True)
 
 
 def _signal(process: subprocess.Popen, sig: int) -> None:
