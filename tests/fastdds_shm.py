@@ -15,6 +15,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from tests import proc
+
 SHM_DIR = Path("/dev/shm")
 LOCK_FILE = re.compile(r"^fastrtps_(port\d{1,5}|[0-9a-z]{16})_(el|sl)$")
 
@@ -57,20 +59,8 @@ def held_by(pid: int) -> set[str]:
     """The Fast DDS lock files a running process holds open now (its ports and segments): what it leaves behind if
     it dies without cleaning up. Judging only these keeps a check to its own test's processes, whatever other
     DDS processes (a parallel test worker's) do meanwhile."""
-    held = set()
-    fd_dir = Path("/proc") / str(pid) / "fd"
-    try:
-        entries = os.listdir(fd_dir)
-    except OSError:
-        return held
-    for entry in entries:
-        try:
-            target = Path(os.readlink(fd_dir / entry))
-        except OSError:
-            continue
-        if target.parent == SHM_DIR and LOCK_FILE.match(target.name):
-            held.add(target.name)
-    return held
+    targets = (Path(target) for target in proc.open_files(pid).values())
+    return {t.name for t in targets if t.parent == SHM_DIR and LOCK_FILE.match(t.name)}
 
 
 # RTPS well-known ports (the Fast DDS shared-memory transport uses the same numbers): PB + DG * domain + offset

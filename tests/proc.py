@@ -69,17 +69,23 @@ def session(pid: int) -> int | None:
     return None if fields is None else int(fields[4])
 
 
+def open_files(pid: int) -> dict[int, str]:
+    """What each open file descriptor of a process points to (a path, `pipe:[inode]`, `socket:[inode]`); empty for
+    a process that is gone."""
+    fd_dir = PROC / str(pid) / "fd"
+    try:
+        entries = os.listdir(fd_dir)
+    except OSError:
+        return {}
+    found = {}
+    for entry in entries:
+        try:
+            found[int(entry)] = os.readlink(fd_dir / entry)
+        except OSError:  # closed meanwhile
+            continue
+    return found
+
+
 def pipe_inodes(pid: int) -> set[str]:
     """The pipes a process holds open beyond its standard input, output and error."""
-    found = set()
-    fd_dir = PROC / str(pid) / "fd"
-    for entry in os.listdir(fd_dir):
-        if int(entry) <= 2:
-            continue
-        try:
-            target = os.readlink(fd_dir / entry)
-        except OSError:
-            continue
-        if target.startswith("pipe:["):
-            found.add(target)
-    return found
+    return {target for fd, target in open_files(pid).items() if fd > 2 and target.startswith("pipe:[")}

@@ -35,7 +35,7 @@ CHILD = textwrap.dedent("""
 # a supervisor of one CHILD (arguments: what the child ignores), inside signals_as_interrupt as the CLI runs;
 # prints the child's pid, then how it ended
 SUPERVISOR = textwrap.dedent("""
-    import sys, time
+    import subprocess, sys, time
     from gryffin_ros.nodes.supervisor import Interrupted, Supervisor, signals_as_interrupt
     with signals_as_interrupt():
         supervisor = Supervisor(stop_timeout_s=2.0, kill_timeout_s=2.0)
@@ -51,7 +51,7 @@ SUPERVISOR = textwrap.dedent("""
             for end in supervisor.stop():
                 print(end, flush=True)
     sys.exit(code)
-""").replace("import sys, time", "import subprocess, sys, time")
+""")
 
 
 def start_supervisor(*ignore: str) -> tuple[subprocess.Popen, tuple[int, int]]:
