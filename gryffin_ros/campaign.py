@@ -11,6 +11,12 @@ it; the node only translates messages. What it guarantees:
 - experiment ids, pending proposals, failures and the best experiment are kept here, once;
 - restarting on the same store continues the campaign: same seed, same counters, the experiments still owed.
 
+Serving a lab (what the planner node does with it, tested here without ROS): `serve` opens the ask queue
+(`asks.AskQueue`: every proposal on one thread, in order, each stoppable by its caller) and returns the experiments
+still owed, to be announced again; `recommend` is a lab's ask; `auto_proposals` are the next proposals published
+unasked once nothing is owed — not after an ask failed, until new data arrives; `owed_after_quiet` are the experiments
+to announce again when nothing has come in for REMIND_AFTER_S; `stop_serving` stops the running asks.
+
 Pending proposals follow one rule: a proposal stays pending until an observation reports it. Proposals published
 without being asked for (auto-propose) are *unclaimed*; `claim` (the node's recommend) hands out unclaimed pending
 proposals first, each once, and asks the planner only for the rest, so an auto-published batch is never left
@@ -25,11 +31,13 @@ import copy
 import ctypes
 import logging
 import threading
+import time
 import uuid
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from .asks import AskQueue, NotServing
 from .planner import Observation, Planner, Proposal
 from .planner.config import PlannerConfig, load_config, read_config
 from .planner.errors import GryffinRosError, ObservationError
@@ -40,6 +48,8 @@ logger = logging.getLogger(__name__)
 
 # While another proposal holds the planner, a caller with a progress callback hears "waiting" this often.
 WAIT_REPORT_S = 0.25
+# experiments still owed after this long without an observation are announced again (a report may have been lost)
+REMIND_AFTER_S = 5.0
 
 ConstraintArg = Callable[[dict], bool] | Sequence[Callable[[dict], bool]] | None
 
@@ -113,6 +123,11 @@ class Campaign:
         self._n_failed = sum(o.failed for o in observations)
         self._best = self.planner.best()
         self._state = "idle"
+        self.asks = AskQueue()  # closed until `serve`
+        self._blocked = False  # an ask failed: nothing is proposed unasked until new data arrives
+        self._last_input = time.monotonic()
+        self.last_ask_s: float | None = None
+        self.last_error: str | None = None
 
     def _tuned(self, settings: Mapping[str, Any]) -> PlannerConfig:
         tuned = copy.deepcopy(self._raw)
@@ -218,6 +233,7 @@ class Campaign:
             self._pending.pop(experiment_id, None)
             self._claims.pop(experiment_id, None)
             self._n_failed += observation.failed
+            self._last_input, self._blocked = time.monotonic(), False
         if self._planner_lock.acquire(blocking=False):  # never wait for a running optimization here
             try:
                 self._absorb()
@@ -349,15 +365,93 @@ class Campaign:
         with self._state_lock:
             self._unclaimed = [i for i in self._pending if i not in self._claims]
 
+    # ---- serving a lab ---------------------------------------------------------------------------------------
+    def serve(self) -> list[Proposal]:
+        """Take asks from now on; proposals are published unasked again. Returns the experiments still owed, each
+        now unclaimed unless a named instrument holds it: announce them (after a restart or a pause)."""
+        with self._state_lock:
+            self._blocked, self._last_input = False, time.monotonic()
+        self.mark_unclaimed()
+        self.asks.open()
+        return self.pending
+
+    def stop_serving(self, reason: str, wait: bool = True) -> None:
+        """Refuse new asks and stop the running ones at their next checkpoint (their callers hear `reason`); with
+        `wait`, return once they have ended. Observations are still taken until `close`."""
+        self.asks.close(reason, wait)
+
+    def recommend(self, n: int | None = None, *, instrument: str = "", claimed: bool = True,
+                  progress: ProgressCallback | None = None, cancelled: Callable[[], bool] = lambda: False
+                  ) -> list[Proposal]:
+        """A lab's ask, through the queue: `claim(n, instrument)` (`claimed=False`: new proposals published unasked,
+        as `propose(n, False)`). `progress` hears the stages (and "waiting" while queued); the ask stops at its next
+        checkpoint once `cancelled()` (Cancelled) or `stop_serving` (asks.Stopped). A failure is raised as a
+        GryffinRosError (a bug too, logged) and blocks unasked proposals until new data arrives."""
+        started = time.monotonic()
+
+        def make(checkpoint: ProgressCallback) -> list[Proposal]:
+            if claimed:
+                return self.claim(n, checkpoint, instrument)
+            return self.propose(n, claimed=False, progress=checkpoint)
+
+        try:
+            proposals = self.asks.run(make, progress, cancelled)
+        except (Cancelled, NotServing):
+            raise
+        except Exception as exc:
+            if not isinstance(exc, GryffinRosError):  # a bug: report it, keep the campaign and its data alive
+                logger.exception("internal error while proposing")
+                exc = GryffinRosError(f"internal error: {exc!r}")
+            with self._state_lock:
+                self._blocked, self.last_error = True, str(exc)
+            raise exc from None
+        with self._state_lock:
+            self.last_ask_s = time.monotonic() - started
+        return proposals
+
+    def auto_proposals(self, n: int | None = None, progress: ProgressCallback | None = None) -> list[Proposal]:
+        """The next proposals to publish unasked: none while experiments are owed, while not serving, or after a
+        failed ask until new data arrives. Raises as `recommend`."""
+        with self._state_lock:
+            if self._blocked or self._pending or self._closed:
+                return []
+        try:
+            return self.recommend(n, claimed=False, progress=progress)
+        except NotServing:
+            return []
+
+    def owed_after_quiet(self) -> list[Proposal]:
+        """The experiments still owed once nothing has come in for REMIND_AFTER_S (then the quiet spell starts
+        over): announce them again, a report or an announcement may have been lost."""
+        with self._state_lock:
+            if time.monotonic() - self._last_input <= REMIND_AFTER_S:
+                return []
+            self._last_input = time.monotonic()
+            return list(self._pending.values())
+
+    def recent_rejections(self, window_s: float) -> list[str]:
+        """Reasons of the observations refused in the last `window_s` seconds, oldest first (from the store)."""
+        with self._state_lock:
+            if self._closed:
+                return []
+            self._active += 1
+        try:
+            return [r["reason"] for r in self.store.rejections(since=time.time() - window_s)]
+        finally:
+            with self._state_lock:
+                self._active -= 1
+                self._state_lock.notify_all()
+
     # ---- lifetime ------------------------------------------------------------------------------------------
     def close(self) -> None:
-        """Refuse new observations, wait for those being stored and for a running optimization to finish its
-        writes, then release the store."""
+        """Stop serving, refuse new observations, wait for those being stored and for a running optimization to
+        finish its writes, then release the store."""
         with self._state_lock:
             if self._closed:
                 return
             self._closed = True
             self._state_lock.wait_for(lambda: self._active == 0)
+        self.asks.shutdown()
         with self._planner_lock:
             self.store.close()
 

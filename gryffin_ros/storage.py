@@ -224,10 +224,12 @@ class CampaignStore:
             self._db.execute("INSERT INTO rejections (experiment_id, reason, raw, received) VALUES (?, ?, ?, ?)",
                              (experiment_id, reason, None if raw is None else raw[:REJECTED_RAW_CHARS], time.time()))
 
-    def rejections(self) -> list[dict[str, Any]]:
-        """Refused observations, oldest first (none in a store written before they were recorded)."""
+    def rejections(self, since: float | None = None) -> list[dict[str, Any]]:
+        """Refused observations, oldest first (received at `since`, a time.time(), or later when given; none in a
+        store written before they were recorded)."""
         try:
-            rows = self._query("SELECT experiment_id, reason, received FROM rejections ORDER BY seq")
+            rows = self._query("SELECT experiment_id, reason, received FROM rejections WHERE received >= ? ORDER BY "
+                               "seq", (float("-inf") if since is None else since,))
         except sqlite3.OperationalError:
             return []
         return [{"experiment_id": eid, "reason": reason, "received": received} for eid, reason, received in rows]

@@ -285,3 +285,140 @@ def test_every_ask_gives_its_freed_memory_back_also_when_it_fails(tmp_path, monk
         campaign.propose(1)
     assert calls == ["ask", "trim", "ask", "trim"]
     campaign.close()
+
+
+# ---- serving a lab: the node's policy, without ROS ----------------------------------------------------------------
+def test_nothing_is_asked_before_serving_and_auto_proposals_wait_for_what_is_owed(tmp_path):
+    from gryffin_ros.asks import NotServing
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    with pytest.raises(NotServing, match="not active"):
+        campaign.recommend(1)
+    assert campaign.auto_proposals(1) == [] and campaign.pending == []
+    assert campaign.serve() == []
+    published = campaign.auto_proposals(2)
+    assert len(published) == 2 and campaign.pending == published
+    assert campaign.auto_proposals(2) == []  # owed: nothing more until they are reported
+    campaign.observe(report(published[0]))
+    assert campaign.auto_proposals(2) == []
+    campaign.observe(report(published[1]))
+    assert len(campaign.auto_proposals(2)) == 2
+    # unasked proposals are what the next ask is handed first
+    assert campaign.recommend(2) == campaign.pending
+
+
+def test_a_failed_ask_blocks_auto_proposals_until_new_data_arrives(tmp_path, monkeypatch):
+    from gryffin_ros.planner import GryffinRosError
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    campaign.serve()
+    asked = campaign.recommend(1)
+
+    def broken(n=None):
+        raise RuntimeError("optimizer crashed")
+    monkeypatch.setattr(campaign.planner, "ask", broken)
+    campaign.observe(report(asked[0]))
+    with pytest.raises(GryffinRosError, match="internal error: RuntimeError"):  # a bug, said, not raised as is
+        campaign.auto_proposals(1)
+    assert campaign.last_error and "optimizer crashed" in campaign.last_error
+    monkeypatch.undo()
+    assert campaign.auto_proposals(1) == []  # blocked: asking again on the same data would fail again
+    one = campaign.recommend(1)  # a lab's own ask is never blocked
+    campaign.observe(report(one[0]))
+    assert len(campaign.auto_proposals(1)) == 1 and campaign.last_ask_s is not None
+
+
+def test_the_experiments_owed_are_announced_again_after_a_quiet_spell_only(tmp_path, monkeypatch):
+    from gryffin_ros import campaign as module
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    campaign.serve()
+    owed = campaign.recommend(2)
+    monkeypatch.setattr(module, "REMIND_AFTER_S", 3600.0)
+    assert campaign.owed_after_quiet() == []  # just served: not quiet
+    monkeypatch.setattr(module, "REMIND_AFTER_S", -1.0)  # any spell counts as quiet
+    assert campaign.owed_after_quiet() == owed
+    campaign.observe(report(owed[0]))
+    assert campaign.owed_after_quiet() == owed[1:]
+
+
+def test_an_ask_stops_when_its_caller_cancels_or_serving_stops_and_leaves_nothing_behind(tmp_path):
+    import threading
+
+    from gryffin_ros.asks import Stopped
+    from gryffin_ros.planner.reporting import Cancelled
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    campaign.serve()
+    for proposal in campaign.recommend(3):
+        campaign.observe(report(proposal))
+    with pytest.raises(Cancelled, match="canceled by the client"):
+        campaign.recommend(1, cancelled=lambda: True)
+    assert campaign.pending == []
+
+    optimizing = threading.Event()
+
+    def progress(stage, fraction, ready):
+        if stage == "optimizing":
+            optimizing.set()
+    outcome = []
+
+    def ask():
+        try:
+            campaign.recommend(1, progress=progress)
+        except Stopped as exc:
+            outcome.append(str(exc))
+    asker = threading.Thread(target=ask)
+    asker.start()
+    assert optimizing.wait(60)
+    campaign.stop_serving("deactivated by the test")  # returns once the running ask has ended
+    assert campaign.asks.settled() and outcome == ["deactivated by the test"]
+    asker.join(10)
+    assert campaign.pending == [] and campaign.status()["state"] == "idle"
+    assert campaign.serve() == [] and len(campaign.recommend(1)) == 1  # serving again
+
+
+def test_an_ask_queued_behind_another_waits_and_can_be_stopped_before_it_starts(tmp_path):
+    import threading
+
+    from gryffin_ros.asks import AskQueue, Stopped
+    queue = AskQueue()
+    queue.open()
+    release, running = threading.Event(), threading.Event()
+
+    def first(checkpoint):
+        running.set()
+        assert release.wait(60)
+        return "first"
+    heard, outcome = [], {}
+
+    def run(name, make, **kw):
+        try:
+            outcome[name] = queue.run(make, **kw)
+        except Stopped as exc:
+            outcome[name] = exc
+    t1 = threading.Thread(target=run, args=("first", first))
+    t1.start()
+    assert running.wait(60)
+    waiting = threading.Event()
+
+    def progress(stage, fraction, ready):
+        heard.append(stage)
+        waiting.set()
+    t2 = threading.Thread(target=run, args=("second", lambda checkpoint: "second"), kwargs={"progress": progress})
+    t2.start()
+    assert waiting.wait(60) and set(heard) == {"waiting"}
+    queue.close("stopped by the test", wait=False)
+    t2.join(10)
+    assert isinstance(outcome["second"], Stopped)  # never started
+    release.set()
+    t1.join(10)
+    assert outcome["first"] == "first" and queue.settled()
+    queue.shutdown()
+
+
+def test_recent_rejections_are_read_from_the_store(tmp_path):
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    campaign.reject("not JSON", "{", None)
+    with pytest.raises(Rejected):
+        campaign.observe({"experiment_id": "nope", "params": {"x": 1.0, "solvent": "THF"}, "objectives": {"y": 1}})
+    assert campaign.recent_rejections(60.0)[0] == "not JSON" and len(campaign.recent_rejections(60.0)) == 2
+    assert campaign.recent_rejections(-60.0) == []  # a window ending a minute ago holds none of them
+    campaign.close()
+    assert campaign.recent_rejections(60.0) == []
