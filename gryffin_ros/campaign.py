@@ -5,11 +5,11 @@ it; the node only translates messages. What it guarantees:
 
 - the store is held exclusively (a second process on the same file is refused at once, naming the holder);
 - each observation is validated exactly once, when it arrives, and committed before `observe` returns (a caller
-  acknowledges after `observe`, so nothing acknowledged can be lost); the planner learns it after the commit, and
-  if the planner cannot take it then, it is kept and taught again before the next proposal — never lost, never
-  reported twice;
-- experiment ids, pending proposals, failures and the best experiment are kept here, once;
-- restarting on the same store continues the campaign: same seed, same counters, the experiments still owed.
+  acknowledges after `observe`, so nothing acknowledged can be lost); never reported twice;
+- the store is the campaign's record (proposals, claims, observations, rejections, the ask and proposal counts);
+  the campaign keeps a cache of it (a planner `History`) and hands the planner a snapshot of it for each proposal:
+  the planner keeps no copy, and a proposal that could not be stored leaves nothing to undo;
+- restarting on the same store continues the campaign: same seed, same counts, the experiments still owed.
 
 Serving a lab (what the planner node does with it, tested here without ROS): `serve` opens the ask queue
 (`asks.AskQueue`: every proposal on one thread, in order, each stoppable by its caller) and returns the experiments
@@ -41,6 +41,7 @@ from .asks import AskQueue, NotServing
 from .planner import Observation, Planner, Proposal
 from .planner.config import PlannerConfig, load_config, read_config
 from .planner.errors import GryffinRosError, ObservationError
+from .planner.history import History
 from .planner.reporting import Cancelled, ProgressCallback, reporting
 from .storage import CampaignStore
 
@@ -105,23 +106,23 @@ class Campaign:
             # a new campaign: the seed given, else the config's, else a random one (the Planner's rule)
             self.planner = Planner(config_used, known_constraints, seed)
             self.store.set_meta("seed", str(self.planner.seed))
-            observations = self.store.observations()
-            self.planner.restore(observations, self.store.pending(), int(self.store.get_meta("ask_count") or 0),
-                                 int(self.store.get_meta("proposal_count") or 0))
+            # the cache of the store: what is stored, as the planner reads it
+            self._history = History(self.store.observations(), {p.experiment_id: p for p in self.store.pending()},
+                                    int(self.store.get_meta("ask_count") or 0),
+                                    int(self.store.get_meta("proposal_count") or 0))
+            self.planner.history = self._history.snapshot()
         except BaseException:
             self.store.close()
             raise
-        self._state_lock = threading.Condition()  # bookkeeping below; never held while the planner works
+        self._state_lock = threading.Condition()  # the cache and bookkeeping; never held while the planner works
         self._active = 0  # observe() calls in progress (close waits for them)
         self._closed = False
-        self._planner_lock = threading.Lock()  # the planner: one ask or one lesson at a time
-        self._reported = {o.experiment_id for o in observations}
-        self._pending: dict[str, Proposal] = dict(self.planner.pending)
+        self._planner_lock = threading.Lock()  # the planner: one ask or one ranking at a time
+        self._arriving: set[str] = set()  # ids of observations being committed (a concurrent duplicate is refused)
         self._unclaimed: list[str] = []  # pending ids published but not yet handed to anyone asking
         self._claims: dict[str, str] = self.store.claims()  # pending id -> the instrument it was handed to
-        self._inbox: list[Observation] = []  # committed, not yet learnt by the planner
-        self._n_failed = sum(o.failed for o in observations)
         self._best = self.planner.best()
+        self._best_stale = False  # an observation arrived while the planner was busy
         self._state = "idle"
         self.asks = AskQueue()  # closed until `serve`
         self._blocked = False  # an ask failed: nothing is proposed unasked until new data arrives
@@ -153,13 +154,18 @@ class Campaign:
     @property
     def n_observations(self) -> int:
         with self._state_lock:
-            return len(self._reported)
+            return len(self._history.observations)
 
     @property
     def pending(self) -> list[Proposal]:
         """Proposals still owed an observation, oldest first."""
         with self._state_lock:
-            return list(self._pending.values())
+            return list(self._history.pending.values())
+
+    def history(self) -> History:
+        """A snapshot of what the campaign has stored: observations, pending proposals, ask and proposal counts."""
+        with self._state_lock:
+            return self._history.snapshot()
 
     @property
     def best(self) -> Observation | None:
@@ -176,9 +182,11 @@ class Campaign:
         warnings = self.warnings  # the first time this studies the domain: not under the lock observations need
         with self._state_lock:
             best = self._best
+            history = self._history
             return {
-                "campaign": self.name, "n_observations": len(self._reported), "n_pending": len(self._pending),
-                "n_failed": self._n_failed, "state": self._state,
+                "campaign": self.name, "n_observations": len(history.observations),
+                "n_pending": len(history.pending), "n_failed": sum(o.failed for o in history.observations),
+                "state": self._state,
                 "best": None if best is None else {"experiment_id": best.experiment_id, "params": best.params,
                                                    "objectives": best.objectives},
                 "warnings": warnings,
@@ -210,13 +218,13 @@ class Campaign:
                 if not self.accept_unsolicited:
                     raise Rejected("an observation needs the experiment_id of the proposal it reports")
                 experiment_id = observation.experiment_id = str(uuid.uuid4())
-            if experiment_id in self._reported:
+            if self._history.reported(experiment_id) or experiment_id in self._arriving:
                 raise Rejected(f"experiment_id '{experiment_id}' was already reported; the first report stands")
-            if experiment_id not in self._pending and not self.accept_unsolicited:
+            if experiment_id not in self._history.pending and not self.accept_unsolicited:
                 raise Rejected(f"unknown experiment_id '{experiment_id}': this planner did not propose it (set "
                                "accept_unsolicited to accept prior data)")
-            # claimed under the lock: a concurrent duplicate is refused above, and nobody is handed it meanwhile
-            self._reported.add(experiment_id)
+            # reserved under the lock: a concurrent duplicate is refused above, and nobody is handed it meanwhile
+            self._arriving.add(experiment_id)
             was_unclaimed = experiment_id in self._unclaimed
             if was_unclaimed:
                 self._unclaimed.remove(experiment_id)
@@ -224,22 +232,19 @@ class Campaign:
             self.store.add_observation(observation, raw)
         except BaseException:
             with self._state_lock:
-                self._reported.discard(experiment_id)
+                self._arriving.discard(experiment_id)
                 if was_unclaimed:
                     self._unclaimed.insert(0, experiment_id)
             raise
-        with self._state_lock:
-            self._inbox.append(observation)
-            self._pending.pop(experiment_id, None)
+        with self._state_lock:  # stored: now in the cache
+            self._history.add_observations([observation])
+            self._arriving.discard(experiment_id)
             self._claims.pop(experiment_id, None)
-            self._n_failed += observation.failed
             self._last_input, self._blocked = time.monotonic(), False
+            self._best_stale = True
         if self._planner_lock.acquire(blocking=False):  # never wait for a running optimization here
             try:
-                self._absorb()
-            except Exception:  # committed is committed: the planner is taught again before its next proposal
-                logger.exception("the planner could not learn observation %s now; it is kept and taught again "
-                                 "before the next proposal", experiment_id)
+                self._rank()
             finally:
                 self._planner_lock.release()
         return observation
@@ -260,24 +265,24 @@ class Campaign:
                 self._active -= 1
                 self._state_lock.notify_all()
 
-    def _absorb(self) -> None:
-        """Teach the planner what was committed since last time (caller holds the planner lock). If the planner
-        raises, the observations stay in the inbox for the next try: committed data is never dropped."""
+    def _rank(self) -> None:
+        """The best observation of what is stored now (caller holds the planner lock); the planner's values grow
+        with the history. If ranking fails (a bug), it is logged and tried again after the next proposal: the
+        observation is stored whatever happens here."""
         with self._state_lock:
-            inbox = list(self._inbox)
-        if not inbox:
+            if not self._best_stale:
+                return
+            self._best_stale = False
+            self.planner.history = self._history.snapshot()
+        try:
+            best = self.planner.best()
+        except Exception:  # noqa: BLE001
+            logger.exception("could not rank the observations; the best is looked for again after the next proposal")
+            with self._state_lock:
+                self._best_stale = True
             return
-        self.planner.record(inbox)
-        with self._state_lock:  # learnt: out of the inbox before anything else can fail
-            del self._inbox[:len(inbox)]
-        best = self.planner.best()
         with self._state_lock:
             self._best = best
-
-    def absorb(self) -> None:
-        """Teach the planner every committed observation now (waits for a running optimization)."""
-        with self._planner_lock:
-            self._absorb()
 
     # ---- proposals -----------------------------------------------------------------------------------------
     def propose(self, n: int | None = None, claimed: bool = True,
@@ -306,28 +311,24 @@ class Campaign:
             if self._closed:
                 raise CampaignClosed(f"campaign '{self.name}' is closed; nothing is proposed")
             self._state = "optimizing"
-        counters = (self.planner.ask_count, self.planner.proposal_count)
-        proposals: list[Proposal] = []
+            self.planner.history = self._history.snapshot()  # what is stored now
         try:
-            self._absorb()
             try:
-                proposals = self.planner.ask(n)
+                proposals, ask_count, proposal_count = self.planner.draw(n)
             finally:
                 give_back_freed_memory()
-            self.store.add_proposals(proposals, {"ask_count": str(self.planner.ask_count),
-                                                 "proposal_count": str(self.planner.proposal_count)})
+            # stored before they count as proposed: one that could not be stored was never proposed
+            self.store.add_proposals(proposals, {"ask_count": str(ask_count), "proposal_count": str(proposal_count)})
         except BaseException as exc:
-            if proposals:  # asked but not stored: the planner forgets them, as if never asked
-                self.planner.retract(proposals, *counters)
             with self._state_lock:
                 self._state = "idle" if isinstance(exc, Cancelled) else "error"
             raise
         with self._state_lock:
-            self._pending.update((p.experiment_id, p) for p in proposals)
+            self._history.add_proposals(proposals, ask_count, proposal_count)
             if not claimed:
                 self._unclaimed += [p.experiment_id for p in proposals]
             self._state = "idle"
-        self._absorb()  # what arrived while optimizing
+        self._rank()  # what arrived while optimizing
         return proposals
 
     def claim(self, n: int | None = None, progress: ProgressCallback | None = None,
@@ -338,32 +339,33 @@ class Campaign:
         lost answer returns the same experiments, and they are never handed to anyone else."""
         n = self.config.general.batches if n is None else n
         with self._state_lock:
+            pending = self._history.pending
             owned = [i for i, owner in self._claims.items() if instrument and owner == instrument
-                     and i in self._pending][:n]
+                     and i in pending][:n]
             room = n - len(owned)
             taken, self._unclaimed = self._unclaimed[:room], self._unclaimed[room:]
-            handed = [self._pending[i] for i in owned + taken]
+            handed = [pending[i] for i in owned + taken]
         made: list[Proposal] = []
         if len(handed) < n:
             try:
                 made = self.propose(n - len(handed), progress=progress)
             except BaseException:
                 with self._state_lock:  # nothing was handed out: the unclaimed stay unclaimed
-                    self._unclaimed[:0] = [i for i in taken if i in self._pending]
+                    self._unclaimed[:0] = [i for i in taken if i in self._history.pending]
                 raise
         if instrument:
             fresh = taken + [p.experiment_id for p in made]
             if fresh:
                 self.store.add_claims(fresh, instrument)  # stored before anyone is told
                 with self._state_lock:
-                    self._claims.update((i, instrument) for i in fresh if i in self._pending)
+                    self._claims.update((i, instrument) for i in fresh if i in self._history.pending)
         return handed + made
 
     def mark_unclaimed(self) -> None:
         """Every pending proposal not claimed by a named instrument becomes unclaimed again (after a restart they
         are announced to everyone; an instrument's claims stay its own)."""
         with self._state_lock:
-            self._unclaimed = [i for i in self._pending if i not in self._claims]
+            self._unclaimed = [i for i in self._history.pending if i not in self._claims]
 
     # ---- serving a lab ---------------------------------------------------------------------------------------
     def serve(self) -> list[Proposal]:
@@ -413,7 +415,7 @@ class Campaign:
         """The next proposals to publish unasked: none while experiments are owed, while not serving, or after a
         failed ask until new data arrives. Raises as `recommend`."""
         with self._state_lock:
-            if self._blocked or self._pending or self._closed:
+            if self._blocked or self._history.pending or self._closed:
                 return []
         try:
             return self.recommend(n, claimed=False, progress=progress)
@@ -427,7 +429,7 @@ class Campaign:
             if time.monotonic() - self._last_input <= REMIND_AFTER_S:
                 return []
             self._last_input = time.monotonic()
-            return list(self._pending.values())
+            return list(self._history.pending.values())
 
     def recent_rejections(self, window_s: float) -> list[str]:
         """Reasons of the observations refused in the last `window_s` seconds, oldest first (from the store)."""

@@ -43,28 +43,42 @@ def test_each_observation_is_validated_once_and_learnt_without_parsing_again(tmp
     assert len(campaign.planner.observations) == 3
 
 
-def test_an_observation_the_planner_cannot_take_after_the_commit_is_neither_lost_nor_double_reported(
+def test_an_observation_the_planner_cannot_rank_after_the_commit_is_neither_lost_nor_double_reported(
         tmp_path, monkeypatch):
     path = tmp_path / "c.sqlite"
     campaign = Campaign(CONFIG, path, seed=0)
     first, second = campaign.propose(2)
-    record = campaign.planner.record
+    best = campaign.planner.best
 
-    def broken(observations):
-        raise RuntimeError("planner busy elsewhere")
-    monkeypatch.setattr(campaign.planner, "record", broken)
+    def broken():
+        raise RuntimeError("ranking crashed")
+    monkeypatch.setattr(campaign.planner, "best", broken)
     observation = campaign.observe(report(first))  # committed: the caller may acknowledge it
     assert stored_ids(path) == [first.experiment_id]
-    assert campaign.n_observations == 1 and campaign.planner.observations == []
+    assert campaign.n_observations == 1 and campaign.best is None
     with pytest.raises(Rejected, match="already reported"):
         campaign.observe(report(first, value=2.0))
-    with pytest.raises(RuntimeError):  # the planner still cannot learn: nothing is proposed, nothing dropped
-        campaign.propose(1)
-    monkeypatch.setattr(campaign.planner, "record", record)
-    campaign.observe(report(second))
-    assert [o.experiment_id for o in campaign.planner.observations] == [first.experiment_id, second.experiment_id]
-    assert campaign.planner.observations[0] is observation
+    monkeypatch.setattr(campaign.planner, "best", best)
+    campaign.propose(1)  # the planner learns from what is stored; the best is looked for again
+    assert campaign.planner.observations[0] is observation and campaign.best is observation
+    campaign.observe(report(second, value=5.0))
+    assert [o.experiment_id for o in campaign.history().observations] == [first.experiment_id, second.experiment_id]
+    assert campaign.best.experiment_id == second.experiment_id
     assert stored_ids(path) == [first.experiment_id, second.experiment_id]
+
+
+def test_the_planner_keeps_no_copy_of_the_campaign(tmp_path):
+    """What the planner learns from is the campaign's snapshot of its store, handed over for each proposal: an
+    observation stored while nothing is asked is in the next proposal's history, not copied into the planner."""
+    campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
+    proposals = campaign.propose(2)
+    campaign.observe(report(proposals[0]))
+    stored = campaign.history()
+    assert [o.experiment_id for o in stored.observations] == [proposals[0].experiment_id]
+    assert list(stored.pending) == [proposals[1].experiment_id] and stored.ask_count == 1
+    campaign.propose(1)
+    assert campaign.planner.history.observations == stored.observations
+    assert campaign.planner.history is not campaign.history()
 
 
 def test_refused_observations_store_nothing(tmp_path):
@@ -218,7 +232,7 @@ def test_status_says_optimizing_while_proposing_and_a_failed_claim_keeps_the_unc
 
     def broken(n=None):
         raise RuntimeError("optimizer crashed")
-    monkeypatch.setattr(campaign.planner, "ask", broken)
+    monkeypatch.setattr(campaign.planner, "draw", broken)
     with pytest.raises(RuntimeError):
         campaign.claim(2)  # one unclaimed, one to make: the making fails
     assert campaign.status()["state"] == "error"
@@ -236,7 +250,7 @@ def test_proposals_the_store_could_not_take_are_forgotten_and_drawn_again(tmp_pa
     monkeypatch.setattr(campaign.store, "add_proposals", full_disk)
     with pytest.raises(OSError):
         campaign.propose(2)
-    assert campaign.planner.pending == {} and campaign.planner.ask_count == 0 and campaign.pending == []
+    assert campaign.pending == [] and campaign.history().ask_count == 0
     monkeypatch.undo()
     # same seed, same (restored) counters, same process: the very same computation as the reference's first ask
     assert [p.params for p in campaign.propose(2)] == [p.params for p in reference]
@@ -276,11 +290,11 @@ def test_every_ask_gives_its_freed_memory_back_also_when_it_fails(tmp_path, monk
     calls = []
     monkeypatch.setattr(module, "give_back_freed_memory", lambda: calls.append("trim"))
     campaign = Campaign(CONFIG, tmp_path / "c.sqlite", seed=0)
-    asked = campaign.planner.ask
-    monkeypatch.setattr(campaign.planner, "ask", lambda n=None: calls.append("ask") or asked(n))
+    asked = campaign.planner.draw
+    monkeypatch.setattr(campaign.planner, "draw", lambda n=None: calls.append("ask") or asked(n))
     campaign.propose(2)
     assert calls == ["ask", "trim"]
-    monkeypatch.setattr(campaign.planner, "ask", lambda n=None: calls.append("ask") or 1 / 0)
+    monkeypatch.setattr(campaign.planner, "draw", lambda n=None: calls.append("ask") or 1 / 0)
     with pytest.raises(ZeroDivisionError):
         campaign.propose(1)
     assert calls == ["ask", "trim", "ask", "trim"]
@@ -314,7 +328,7 @@ def test_a_failed_ask_blocks_auto_proposals_until_new_data_arrives(tmp_path, mon
 
     def broken(n=None):
         raise RuntimeError("optimizer crashed")
-    monkeypatch.setattr(campaign.planner, "ask", broken)
+    monkeypatch.setattr(campaign.planner, "draw", broken)
     campaign.observe(report(asked[0]))
     with pytest.raises(GryffinRosError, match="internal error: RuntimeError"):  # a bug, said, not raised as is
         campaign.auto_proposals(1)

@@ -172,9 +172,7 @@ class PlannerNode(LifecycleNode):
         self._release()
         return TransitionCallbackReturn.SUCCESS
 
-    def on_error(self, state) -> TransitionCallbackReturn:
-        self._release()
-        return TransitionCallbackReturn.SUCCESS
+    on_error = on_cleanup  # back to unconfigured, released
 
     def _release(self) -> None:
         """Close the dashboard and the campaign, remove the publishers (back to unconfigured)."""
@@ -265,12 +263,12 @@ class PlannerNode(LifecycleNode):
         if owed:
             self.outputs.proposals(owed)
 
+    def _on_goal(self, goal: Recommend.Goal) -> GoalResponse:
+        return GoalResponse.ACCEPT if self._active and not self._closing else GoalResponse.REJECT
+
     def _auto_propose(self) -> None:
         if self.p["auto_propose"] and self._active and not self._closing:
             self.asks.auto_propose()
-
-    def _on_goal(self, goal: Recommend.Goal) -> GoalResponse:
-        return GoalResponse.ACCEPT if self._active and not self._closing else GoalResponse.REJECT
 
 
 def start(node: PlannerNode) -> None:

@@ -76,7 +76,6 @@ def test_the_best_kept_as_observations_arrive_is_the_best_of_all_of_them():
                 for x, y, c in zip(rng.random(5), rng.uniform(0.5, 1.0, 5), rng.uniform(0.001, 0.01, 5))]
         planner.tell(rows)
         assert planner.best() is best_of(planner.config, planner.observations)
-    restored = Planner(config, seed=0)
-    restored.restore(planner.observations, [], 0, 0)
+    restored = Planner(config, seed=0, history=planner.history.snapshot())
     assert restored.best() is best_of(planner.config, planner.observations)
     assert len(planner.successful_values()[0]) == sum(not o.failed for o in planner.observations)

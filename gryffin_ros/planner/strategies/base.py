@@ -1,9 +1,10 @@
-"""The ask/tell core shared by every strategy: campaign state and validation, the feasible set, determinism and
-the JSON state.
+"""The ask/tell core shared by every strategy: validation, the feasible set, determinism.
 
-A strategy only implements ``_propose(n, rng)``; validation of observations, pending proposals, determinism (every
-random draw derives from the seed, the number of observations and the number of asks), ``best()`` and the JSON state
-live in :class:`BasePlanner`.
+A strategy only implements ``_propose(n, rng)``; validation of observations, determinism (every random draw derives
+from the seed, the number of observations and the number of asks) and ``best()`` live in :class:`BasePlanner`. What
+it learns from is its `History` (observations, pending proposals, counts), which it is given: its own in-memory one
+when used alone, a campaign's snapshot of its store in a `Campaign`. The planner keeps only what it derives from it
+(internal coordinates, objective values), grown as the history grows.
 """
 
 from __future__ import annotations
@@ -21,14 +22,13 @@ from ..config import PlannerConfig, load_config
 from ..constraints import FeasibleFraction, KnownConstraints
 from ..constraints.equalities import LinearEqualities
 from ..domain import ConstraintArg, Observation, Proposal
-from ..errors import ConfigError, ObservationError
+from ..errors import ConfigError
+from ..history import History
 from ..merit import merits, objective_matrix
 from .feasible import FeasibleRegion
 from .observations import ObservationReader
 
 logger = logging.getLogger(__name__)
-
-STATE_FORMAT = 1
 
 
 def _identity(f: np.ndarray) -> np.ndarray:
@@ -47,7 +47,7 @@ class BasePlanner:
     """Campaign state and validation shared by the kernel-density Planner and the Random/Genetic baselines."""
 
     def __init__(self, config: Mapping | str | Path | PlannerConfig, known_constraints: ConstraintArg = None,
-                 seed: int | None = None):
+                 seed: int | None = None, history: History | None = None):
         self.config = config if isinstance(config, PlannerConfig) else load_config(config)
         full = self.config.space
         # every parameter the user sees; `space` holds the ones the planner models (equality-solved ones excluded)
@@ -69,14 +69,15 @@ class BasePlanner:
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
             raise ConfigError(f"seed must be a non-negative integer, got {seed!r}")
         self.seed = int(seed)
-        self.observations: list[Observation] = []
-        self._observed: np.ndarray | None = None  # observed_points() of the observations so far (they only grow)
-        self._successful: tuple[Observation, ...] = ()  # successful_values() of the first _values_upto observations
+        self.history = History() if history is None else history
+        # derived from the history's first observations (they only grow): observed_points() of the first
+        # len(_observed), successful_values() of the first _values_upto; `_last` is the last observation each covers
+        self._observed: np.ndarray | None = None
+        self._observed_last: Observation | None = None
+        self._successful: tuple[Observation, ...] = ()
         self._values = np.empty((0, len(self.objectives)))
-        self._values_upto = 0
-        self.pending: dict[str, Proposal] = {}
-        self._ask_count = 0
-        self._proposal_count = 0
+        self._values_upto, self._values_last = 0, None
+        self._drawn = 0  # while an ask runs: proposals drawn so far in the campaign (sampling strategies cycle)
         # the feasible region of the known constraints: V_C, uniform and walked feasible draws, a finite feasible set
         self.region = FeasibleRegion(self.constraints, self.config.general, self.seed)
         self._strategies: np.ndarray | None = None  # sampling strategies replacing the config's (recommend)
@@ -86,19 +87,29 @@ class BasePlanner:
         return self.equalities.complete(params, self.parameter_names) if self.equalities else dict(params)
 
     @property
+    def observations(self) -> list[Observation]:
+        """The history's observations, in the order they arrived."""
+        return self.history.observations
+
+    @property
+    def pending(self) -> dict[str, Proposal]:
+        """The history's proposals still owed an observation."""
+        return self.history.pending
+
+    @property
     def ask_count(self) -> int:
         """How many times ask() has run (part of what makes proposals reproducible)."""
-        return self._ask_count
+        return self.history.ask_count
 
     @property
     def proposal_count(self) -> int:
         """How many proposals have been made (the sampling strategies cycle with it)."""
-        return self._proposal_count
+        return self.history.proposal_count
 
     # ---- randomness ------------------------------------------------------------------------------------------
     def _rng(self) -> np.random.Generator:
         """Same seed, same observations, same number of asks -> same draws."""
-        return np.random.default_rng([self.seed, len(self.observations), self._ask_count, 2])
+        return np.random.default_rng([self.seed, len(self.observations), self.ask_count, 2])
 
     # ---- feasible region ------------------------------------------------------------------------------------
     @property
@@ -134,39 +145,15 @@ class BasePlanner:
         if isinstance(observations, (Mapping, Observation)):
             observations = [observations]
         parsed = [self.parse_observation(o) for o in observations]
-        seen = {o.experiment_id for o in self.observations if o.experiment_id is not None}
-        for o in parsed:
-            if o.experiment_id is not None:
-                if o.experiment_id in seen:
-                    raise ObservationError(f"experiment_id '{o.experiment_id}' was already reported")
-                seen.add(o.experiment_id)
-        self.record(parsed)
+        self.history.check_new(parsed)
+        self.history.add_observations(parsed)
         return parsed
 
-    def record(self, observations: Sequence[Observation]) -> None:
-        """Add observations that `parse_observation` has already validated (and whose ids are new), without
-        validating them again: the path of a campaign that validates each observation once, when it arrives."""
-        for o in observations:
-            self.observations.append(o)
-            if o.experiment_id is not None:
-                self.pending.pop(o.experiment_id, None)
-
-    def retract(self, proposals: Sequence[Proposal], ask_count: int, proposal_count: int) -> None:
-        """Take back proposals that never left (their campaign could not store them): no longer pending, and the
-        counters as they were before the ask, so the next ask draws what it would have drawn."""
-        for proposal in proposals:
-            self.pending.pop(proposal.experiment_id, None)
-        self._ask_count, self._proposal_count = int(ask_count), int(proposal_count)
-
-    def restore(self, observations: Sequence[Observation], pending: Sequence[Proposal], ask_count: int,
-                proposal_count: int) -> None:
-        """Put a fresh planner where a campaign left it: its validated observations, the proposals still pending
-        and its counters (which, with the seed, make the next proposals the same as without the restart)."""
-        if self.observations or self.pending:
-            raise RuntimeError("restore() is for a fresh planner")
-        self.record(observations)
-        self.pending = {p.experiment_id: p for p in pending}
-        self._ask_count, self._proposal_count = int(ask_count), int(proposal_count)
+    def _covers(self, upto: int, last: Observation | None) -> bool:
+        """Whether something derived from `upto` observations ending with `last` still describes the first `upto`
+        of the history (a campaign hands the planner a new, longer snapshot of the same observations)."""
+        observations = self.observations
+        return len(observations) >= upto and (upto == 0 or observations[upto - 1] is last)
 
     def _internal(self, rows: Sequence[Mapping[str, Any]]) -> np.ndarray:
         return self.space.to_internal(rows) if rows else np.empty((0, self.space.dim))
@@ -174,12 +161,15 @@ class BasePlanner:
     def observed_points(self) -> np.ndarray:
         """(n, D) internal coordinates of every observation, read-only; converted once per observation (at thousands
         of observations the conversion of all of them took a tenth of an ask, several times per ask)."""
+        if self._observed is not None and not self._covers(len(self._observed), self._observed_last):
+            self._observed = None  # another history
         done = 0 if self._observed is None else len(self._observed)
         if self._observed is None or done < len(self.observations):
             new = self._internal([o.params for o in self.observations[done:]])
             points = new if self._observed is None else np.concatenate([self._observed, new])
             points.flags.writeable = False
             self._observed = points
+            self._observed_last = self.observations[-1] if self.observations else None
         return self._observed
 
     def pending_points(self) -> np.ndarray:
@@ -189,13 +179,16 @@ class BasePlanner:
         """The successful observations so far and their (n, objectives) values in users' units, read-only; grown as
         observations are recorded (collecting them from every record took several ms per observation at
         thousands: the node's acknowledgement of each result waited for it)."""
+        if not self._covers(self._values_upto, self._values_last):  # another history
+            self._successful, self._values = (), np.empty((0, len(self.objectives)))
+            self._values_upto, self._values_last = 0, None
         if self._values_upto < len(self.observations):
             new = [o for o in self.observations[self._values_upto:] if not o.failed]
             if new:
                 values = np.concatenate([self._values, self._objective_matrix(new)])
                 values.flags.writeable = False
                 self._successful, self._values = self._successful + tuple(new), values
-            self._values_upto = len(self.observations)
+            self._values_upto, self._values_last = len(self.observations), self.observations[-1]
         return self._successful, self._values
 
     def _objective_matrix(self, observations: Sequence[Observation]) -> np.ndarray:
@@ -224,25 +217,24 @@ class BasePlanner:
     # ---- proposals -------------------------------------------------------------------------------------------
     def ask(self, n: int | None = None) -> list[Proposal]:
         """The next n proposals (default: general.batches); each feasible, none repeating a point of a finite space
-        that was observed or is pending. Progress goes to the callback of `reporting.reporting`, which may stop the
-        ask by raising `Cancelled` (the planner is then as before the ask)."""
+        that was observed or is pending; added to the history as pending. Progress goes to the callback of
+        `reporting.reporting`, which may stop the ask by raising `Cancelled` (the history is then as before)."""
+        proposals, ask_count, proposal_count = self.draw(n)
+        self.history.add_proposals(proposals, ask_count, proposal_count)
+        return proposals
+
+    def draw(self, n: int | None = None) -> tuple[list[Proposal], int, int]:
+        """`ask` without touching the history: the proposals, and the ask and proposal counts a history that takes
+        them has after them (a campaign stores the three together, then its history has them)."""
         n = self.config.general.batches if n is None else n
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise ValueError(f"n must be a positive integer, got {n!r}")
         rng = self._rng()
-        proposal_count = self._proposal_count
-        try:
-            points, strategies, meta = self._propose(n, rng)
-        except BaseException:  # stopped (Cancelled) or failed: the next ask draws what this one would have
-            self._proposal_count = proposal_count
-            raise
-        self._ask_count += 1
-        proposals = []
-        for strategy, params in zip(strategies, self.space.to_params(points)):
-            proposal = Proposal(str(uuid.uuid4()), self._complete(params), strategy, dict(meta))
-            self.pending[proposal.experiment_id] = proposal
-            proposals.append(proposal)
-        return proposals
+        self._drawn = self.history.proposal_count
+        points, strategies, meta = self._propose(n, rng)
+        proposals = [Proposal(str(uuid.uuid4()), self._complete(params), strategy, dict(meta))
+                     for strategy, params in zip(strategies, self.space.to_params(points))]
+        return proposals, self.history.ask_count + 1, self._drawn
 
     def with_observations(self, observations: Sequence[Mapping[str, Any]] | None = None, draw: int = 0
                           ) -> BasePlanner:
@@ -255,7 +247,7 @@ class BasePlanner:
         fresh.region = self.region  # the same constraints: V_C and the feasible set are not computed again
         if observations:
             fresh.tell(list(observations))
-        fresh._ask_count = int(draw)
+        fresh.history.ask_count = int(draw)
         return fresh
 
     def recommend(self, observations: Sequence[Mapping[str, Any]] | None = None,
@@ -281,28 +273,3 @@ class BasePlanner:
     def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
         """n internal points, the sampling strategy of each and what every proposal of this ask records in meta."""
         raise NotImplementedError
-
-    # ---- persistence -----------------------------------------------------------------------------------------
-    def state(self) -> dict[str, Any]:
-        """A JSON-serializable snapshot; ``from_state`` rebuilds an identical planner (pass callables again)."""
-        return {
-            "format": STATE_FORMAT, "strategy": type(self).__name__, "config": self.config.raw, "seed": self.seed,
-            "observations": [o.to_dict() for o in self.observations],
-            "pending": [p.to_dict() for p in self.pending.values()],
-            "ask_count": self._ask_count, "proposal_count": self._proposal_count,
-        }
-
-    @classmethod
-    def from_state(cls, state: Mapping[str, Any], known_constraints: ConstraintArg = None,
-                   base_dir: str | Path | None = None) -> BasePlanner:
-        """Rebuild a planner from `state()`; `base_dir` resolves relative file names in its config."""
-        if not isinstance(state, Mapping) or state.get("format") != STATE_FORMAT:
-            raise ConfigError(f"not a planner state of format {STATE_FORMAT}")
-        if state.get("strategy") != cls.__name__:
-            raise ConfigError(f"state was saved by {state.get('strategy')!r}, not {cls.__name__}")
-        planner = cls(load_config(state["config"], base_dir), known_constraints, state["seed"])
-        planner.restore([planner.parse_observation(o) for o in state["observations"]],
-                        [Proposal(p["experiment_id"], p["params"], p.get("strategy"), dict(p.get("meta") or {}))
-                         for p in state["pending"]],
-                        state["ask_count"], state["proposal_count"])
-        return planner

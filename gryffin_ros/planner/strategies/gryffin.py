@@ -16,6 +16,7 @@ from ..acquisition.kernel import Acquisition
 from ..config import PlannerConfig
 from ..constraints.sampling import perturb, rejection_sample, spread_seeds
 from ..domain import ConstraintArg, Observation
+from ..history import History
 from ..optimizers import AcquisitionOptimizer, make_optimizer
 from ..reporting import report
 from ..surrogates.choice import SurrogateChoice
@@ -61,8 +62,8 @@ class Planner(BasePlanner):
     constrained optimizers, or the better ranking of the two on the data so far."""
 
     def __init__(self, config: Mapping | str | Path | PlannerConfig, known_constraints: ConstraintArg = None,
-                 seed: int | None = None):
-        super().__init__(config, known_constraints, seed)
+                 seed: int | None = None, history: History | None = None):
+        super().__init__(config, known_constraints, seed, history)
         self.surrogate_choice = SurrogateChoice(self.config.general.surrogate, self.space, self.seed,
                                                 lambda observations: self.merits(observations, transform=False))
 
@@ -212,8 +213,8 @@ class Planner(BasePlanner):
         points, strategies = [], []
         for i in range(n):
             report("selecting", i / n, i)
-            s = float(values[self._proposal_count % len(values)])
-            self._proposal_count += 1
+            s = float(values[self._drawn % len(values)])
+            self._drawn += 1
             if s not in refined:
                 refined[s] = self._candidates(Acquisition(density, s), start, exhaustive, optimizer, rng,
                                               feasibility)

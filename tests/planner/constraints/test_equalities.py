@@ -102,12 +102,12 @@ def test_equality_on_finite_parameters_stays_a_sampled_constraint():
     assert all(p.params["n"] == 3 for p in planner.ask(5))
 
 
-def test_state_round_trip_keeps_the_reparametrization():
+def test_a_planner_given_the_history_keeps_the_reparametrization():
     planner = Planner(blend_config(), seed=5)
     for _ in range(4):
         (proposal,) = planner.ask()
         planner.tell({**proposal.params, "y": response(proposal.params), "experiment_id": proposal.experiment_id})
-    again = Planner.from_state(planner.state())
+    again = Planner(blend_config(), seed=5, history=planner.history.snapshot())
     assert [p.params for p in again.ask(2)] == [p.params for p in planner.ask(2)]
 
 

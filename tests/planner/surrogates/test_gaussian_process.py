@@ -210,7 +210,7 @@ def test_gp_proposals_survive_a_restart_exactly():
     running = Planner(config("gp"), seed=5)
     run(running, 25, bowl)
     assert fit_size(25) == 24
-    restored = Planner.from_state(running.state())
+    restored = Planner(config("gp"), seed=5, history=running.history.snapshot())
     a, b = running.ask()[0].params, restored.ask()[0].params
     assert a == pytest.approx(b, abs=1e-9)
 

@@ -1,0 +1,57 @@
+"""`History`: what a planner learns from and where its draws stand — the observations in the order they arrived, the
+proposals still pending, and the counts of asks and proposals (which, with the seed, make the next proposals
+reproducible).
+
+A planner is given its history; it keeps no copy of its own. Used alone (`Planner.ask` / `tell`), a planner owns an
+in-memory History that those calls grow. In a `Campaign` the store is the record: the campaign hands the planner a
+snapshot of its cache of the store for each proposal and stores what the planner drew before anything counts as
+proposed, so a proposal that could not be stored leaves no trace to undo.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+from .domain import Observation, Proposal
+from .errors import ObservationError
+
+
+@dataclass
+class History:
+    observations: list[Observation] = field(default_factory=list)
+    pending: dict[str, Proposal] = field(default_factory=dict)
+    ask_count: int = 0
+    proposal_count: int = 0
+
+    def __post_init__(self) -> None:
+        self._ids = {o.experiment_id for o in self.observations if o.experiment_id is not None}
+
+    def snapshot(self) -> History:
+        """A copy whose lists later additions here do not change (the observations themselves are shared)."""
+        return History(list(self.observations), dict(self.pending), self.ask_count, self.proposal_count)
+
+    def reported(self, experiment_id: str | None) -> bool:
+        return experiment_id is not None and experiment_id in self._ids
+
+    def check_new(self, observations: Sequence[Observation]) -> None:
+        """ObservationError if an experiment_id was reported before or twice in `observations`."""
+        seen = set()
+        for o in observations:
+            if o.experiment_id is not None:
+                if o.experiment_id in self._ids or o.experiment_id in seen:
+                    raise ObservationError(f"experiment_id '{o.experiment_id}' was already reported")
+                seen.add(o.experiment_id)
+
+    def add_observations(self, observations: Iterable[Observation]) -> None:
+        """Observations whose ids are new (`check_new`): appended, and no longer pending."""
+        for o in observations:
+            self.observations.append(o)
+            if o.experiment_id is not None:
+                self._ids.add(o.experiment_id)
+                self.pending.pop(o.experiment_id, None)
+
+    def add_proposals(self, proposals: Iterable[Proposal], ask_count: int, proposal_count: int) -> None:
+        """Proposals of one ask, now pending, and the counts after it."""
+        self.pending.update((p.experiment_id, p) for p in proposals)
+        self.ask_count, self.proposal_count = int(ask_count), int(proposal_count)
