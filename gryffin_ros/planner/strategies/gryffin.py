@@ -189,6 +189,11 @@ class Planner(BasePlanner):
         rng = self._rng()
         return self._surrogates(torch.Generator().manual_seed(int(rng.integers(2**63))))
 
+    def with_observations(self, observations=None, draw: int = 0) -> Planner:
+        fresh = super().with_observations(observations, draw)
+        fresh.surrogate_choice.fits = self.surrogate_choice.fits  # fits of the same data are not made again
+        return fresh
+
     def _propose(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, list[float | None], dict[str, Any]]:
         observed = self.observed_points()
         chosen = self.pending_points()

@@ -1,11 +1,13 @@
 """general.surrogate: which regression model the next proposals come from — the paper's kernel density (`kde`), a
 Gaussian process (`gp`), the better ranking of the two on the data so far starting from the kernel density (`auto`),
 or (`portfolio`, the default) the same comparison starting from the model that suits the problem's shape — with the
-GP's fitted hyperparameters cached between asks."""
+GP's fitted hyperparameters cached between asks, and between the fresh planners of stateless `recommend` calls."""
 
 from __future__ import annotations
 
+import hashlib
 import math
+from collections import OrderedDict
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -30,6 +32,39 @@ AUTO_MIN_OBSERVATIONS = 5
 PORTFOLIO_GP_MIN_CONTINUOUS = 3
 
 
+class FitCache:
+    """Fitted GP hyperparameters by the data they were fitted to (the fit is a pure function of its data, the
+    campaign seed and the fit size, so a hit gives exactly what a new fit would: same proposals, no fit). Shared by
+    a planner and the fresh planners of its stateless `recommend` calls, which see the same first observations
+    again and again (a Gryffin 1.0 script's loop); the last MAX_ENTRIES fits are kept."""
+
+    MAX_ENTRIES = 4
+
+    def __init__(self) -> None:
+        self._fits: OrderedDict[bytes, dict] = OrderedDict()
+
+    @staticmethod
+    def key(size: int, X: np.ndarray, y: np.ndarray, descriptors: Mapping[int, np.ndarray]) -> bytes:
+        digest = hashlib.blake2b(str(size).encode(), digest_size=20)
+        for array in (X, y, *(np.asarray(descriptors[d]) for d in sorted(descriptors))):
+            array = np.ascontiguousarray(array, dtype=float)
+            digest.update(str(array.shape).encode())
+            digest.update(array.tobytes())
+        return digest.digest()
+
+    def get(self, key: bytes) -> dict | None:
+        fit = self._fits.get(key)
+        if fit is not None:
+            self._fits.move_to_end(key)
+        return fit
+
+    def put(self, key: bytes, hyperparameters: dict) -> None:
+        self._fits[key] = hyperparameters
+        self._fits.move_to_end(key)
+        while len(self._fits) > self.MAX_ENTRIES:
+            self._fits.popitem(last=False)
+
+
 class SurrogateChoice:
     """Chooses the surrogate of each ask. `raw_merits(observations)` gives the untransformed merits of successful
     observations (what the GP regresses: a square root would put a cusp at the optimum)."""
@@ -39,7 +74,7 @@ class SurrogateChoice:
         if setting not in SURROGATES:
             raise ValueError(f"unknown surrogate {setting!r}; choose one of {SURROGATES}")
         self.setting, self.space, self.seed, self.raw_merits = setting, space, seed, raw_merits
-        self._gp_fit: tuple[int, dict] | None = None  # (observations fitted, GP hyperparameters) of the last fit
+        self.fits = FitCache()  # a fresh planner of a stateless recommend shares its parent's
         if setting != "kde":
             from .gaussian_process import require_botorch
             require_botorch()
@@ -48,27 +83,31 @@ class SurrogateChoice:
                          descriptors: Mapping[int, np.ndarray]) -> GaussianProcess:
         """The GP of the untransformed merits, conditioned on every successful experiment (at most COND_MAX of them,
         `condition_subset`), with hyperparameters fitted to the first `fit_size(n)` of them (at most FIT_MAX of those,
-        `fit_subset`; cached; learned descriptors change with every observation, so with them every ask fits). Fits
-        and subsets are seeded by the campaign seed and their size alone, so they never change the draws of the rest
-        of the ask."""
+        `fit_subset`) with their merits among themselves: a fit depends on those first observations alone (learned
+        descriptors change with every observation, so with them every ask fits), and is looked up in `fits` before
+        it is made. Fits and subsets are seeded by the campaign seed and their size alone, so they never change the
+        draws of the rest of the ask."""
         from .gaussian_process import FIT_MAX, GaussianProcess, condition_subset, fit_size, fit_subset
 
         def seed(size: int) -> int:
             return int(np.random.default_rng([self.seed, size, 3]).integers(2**62))
 
         size = len(X) if descriptors else fit_size(len(X))
-        hyperparameters = self._gp_fit[1] if self._gp_fit and self._gp_fit[0] == size else None
         y = self.raw_merits(successful)
+        # several objectives: Chimera's merits depend on every observation's range, so the first `size` are
+        # ranked among themselves (one objective: the same values)
+        y_fit = y if size == len(X) else self.raw_merits(successful[:size])
+        key = self.fits.key(size, X[:size], y_fit, descriptors)
+        hyperparameters = self.fits.get(key)
         if hyperparameters is None and (size < len(X) or size > FIT_MAX):
-            subset = fit_subset(y[:size], seed(size))
-            hyperparameters = GaussianProcess(self.space, X[subset], y[subset], seed(size), descriptors
+            subset = fit_subset(y_fit, seed(size))
+            hyperparameters = GaussianProcess(self.space, X[subset], y_fit[subset], seed(size), descriptors
                                               ).hyperparameters
         # above COND_MAX observations, conditioned on a subset (there size > FIT_MAX: hyperparameters are given)
         kept = condition_subset(y, int(np.random.default_rng([self.seed, len(X), 4]).integers(2**62)))
         gp = GaussianProcess(self.space, X[kept], y[kept], seed(size), descriptors, hyperparameters)
         gp.conditioned = kept
-        if not descriptors:
-            self._gp_fit = (size, gp.hyperparameters)
+        self.fits.put(key, gp.hyperparameters)
         return gp
 
     def prior(self) -> str:

@@ -346,3 +346,43 @@ def test_above_cond_max_the_gp_is_conditioned_on_the_best_and_a_draw_and_both_mo
     assert len(gp.leave_one_out()) == 20
     proposal = planner.ask()[0]
     assert set(proposal.meta["loo_rank_correlation"]) == {"kde", "gp"}
+
+
+def test_stateless_recommend_reuses_a_fit_of_the_same_data_and_proposes_what_a_fresh_fit_would(monkeypatch):
+    """A Gryffin 1.0 script calls recommend on a growing list: each call is a fresh planner, but a fit of the same
+    first observations is looked up instead of made again; the proposals are those of a planner that fits anew."""
+    rng = np.random.default_rng(0)
+    rows = [{"x0": float(a), "x1": float(b), "y": bowl({"x0": a, "x1": b})} for a, b in rng.random((24, 2))]
+    assert fit_size(22) == fit_size(23) == 22
+    planner = Planner(config("gp"), seed=1)
+    planner.recommend(rows[:22])
+    fits = []
+    real_fit = gp_module.fit_gpytorch_mll
+    monkeypatch.setattr(gp_module, "fit_gpytorch_mll", lambda mll: fits.append(1) or real_fit(mll))
+    warm = planner.recommend(rows[:23])
+    assert fits == []  # the fit of the first 22 was reused
+    cold = Planner(config("gp"), seed=1).recommend(rows[:23])
+    assert fits == [1]
+    assert [p["x0"] for p in warm] == pytest.approx([p["x0"] for p in cold], abs=1e-9)
+    assert [p["x1"] for p in warm] == pytest.approx([p["x1"] for p in cold], abs=1e-9)
+    other = [dict(r, y=r["y"] + 1.0 if i == 3 else r["y"]) for i, r in enumerate(rows[:23])]
+    planner.recommend(other)  # another result among the first 22: fitted anew
+    assert fits == [1, 1]
+
+
+def test_with_several_objectives_a_fit_depends_on_its_first_observations_alone():
+    """Chimera's merits depend on the range of every observation: the hyperparameters between refits are fitted to
+    the first observations ranked among themselves, so a planner told them later proposes as one that was there."""
+    cfg = config("gp")
+    cfg["objectives"] = [{"name": "y", "goal": "min", "tolerance": 0.5, "absolute": False},
+                         {"name": "z", "goal": "max"}]
+    running = Planner(cfg, seed=4)
+    for i in range(25):
+        (proposal,) = running.ask()
+        p = proposal.params
+        y = 100.0 if i == 24 else bowl(p)  # the last one widens y's range: the relative tolerance moves
+        running.tell({**p, "y": y, "z": p["x0"], "experiment_id": proposal.experiment_id})
+    assert fit_size(25) == 24
+    restored = Planner(cfg, seed=4, history=running.history.snapshot())
+    a, b = running.ask()[0].params, restored.ask()[0].params
+    assert a == pytest.approx(b, abs=1e-9)
