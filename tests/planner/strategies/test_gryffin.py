@@ -258,3 +258,20 @@ def test_a_report_missing_an_objective_is_refused_and_a_failure_says_so(unit_squ
     (proposal,) = planner.ask()
     planner.tell({**proposal.params, "y": 0.3, "cost": 2.0, "experiment_id": proposal.experiment_id})
     assert planner.best().objectives == {"y": 0.3, "cost": 2.0}
+
+
+def test_a_candidate_a_fraction_of_a_degree_from_an_observation_is_the_same_experiment():
+    """0.02 degC of a 50 degC range from an observed point, same solvent: not a new experiment, whatever its
+    acquisition says; another solvent at the same temperature is."""
+    from gryffin_ros.planner.strategies.selection import DUPLICATE_DISTANCE, select
+    space = Planner({"parameters": [{"name": "T", "type": "continuous", "low": 50.0, "high": 100.0},
+                                    {"name": "solvent", "type": "categorical", "options": ["a", "b", "c"]}],
+                     "objectives": [{"name": "y", "goal": "max"}]}, seed=0).space
+    observed = space.to_internal([{"T": 80.0, "solvent": "b"}])
+    near, other_solvent, far = space.to_internal([{"T": 80.02, "solvent": "b"}, {"T": 80.0, "solvent": "c"},
+                                                  {"T": 60.0, "solvent": "b"}])
+    assert 0.02 / 50.0 < DUPLICATE_DISTANCE < 1.0  # a different option is never within it
+    for diverse in (False, True):
+        assert select(space, np.array([near, far]), np.array([-10.0, 0.0]), observed, observed[:0], diverse) == 1
+        assert select(space, np.array([near, other_solvent]), np.array([-10.0, 0.0]), observed, observed[:0],
+                      diverse) == 1
