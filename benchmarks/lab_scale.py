@@ -151,8 +151,8 @@ def main() -> None:
     rows.append(("stateless recommend, n = 100–119, d = 2, one planner (median of the 20 calls)", "≤ 0.12 s",
                  statistics.median(m for m, _ in loop)))
     rows.append(("the same, mean of the 20 calls (every 10th refits)", "—", statistics.median(m for _, m in loop)))
-    rows.append(("stateless recommend on a fresh planner, n = 100, d = 2 (fit and feasible-region estimate from nothing)", "—",
-                 statistics.median(fresh)))
+    rows.append(("stateless recommend on a fresh planner, n = 100, d = 2 (fit and feasible-region estimate anew)",
+                 "—", statistics.median(fresh)))
 
     lines = [f"Lab-scale ask CPU time, surrogate {label} (median of {a.repeats}; one thread; "
              f"{os.cpu_count()} cores here)", "", "| case | target | CPU s |", "|---|---|---|"]

@@ -23,6 +23,13 @@ class Observation:
     objectives: dict[str, float | None]
     experiment_id: str | None = None
     meta: dict[str, Any] = field(default_factory=dict)
+    # (the search space, its row of internal coordinates): made once, when a planner accepts the observation, and
+    # read by the planners of that space instead of converting the params again; not part of what was observed
+    internal: tuple[Any, np.ndarray] | None = field(default=None, compare=False, repr=False)
+
+    def point_in(self, space: Any) -> np.ndarray | None:
+        """The internal coordinates in `space`, if they were made when it was accepted there."""
+        return self.internal[1] if self.internal is not None and self.internal[0] is space else None
 
     @property
     def failed(self) -> bool:

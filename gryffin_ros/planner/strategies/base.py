@@ -158,6 +158,16 @@ class BasePlanner:
     def _internal(self, rows: Sequence[Mapping[str, Any]]) -> np.ndarray:
         return self.space.to_internal(rows) if rows else np.empty((0, self.space.dim))
 
+    def _points(self, observations: Sequence[Observation]) -> np.ndarray:
+        """Internal coordinates of observations: those made when they were accepted, the others converted now
+        (observations read back from a store)."""
+        points = [o.point_in(self.space) for o in observations]
+        missing = [i for i, p in enumerate(points) if p is None]
+        if missing:
+            for i, row in zip(missing, self._internal([observations[i].params for i in missing])):
+                points[i] = row
+        return np.array(points, dtype=float).reshape(len(observations), self.space.dim)
+
     def observed_points(self) -> np.ndarray:
         """(n, D) internal coordinates of every observation, read-only; converted once per observation (at thousands
         of observations the conversion of all of them took a tenth of an ask, several times per ask)."""
@@ -165,7 +175,7 @@ class BasePlanner:
             self._observed = None  # another history
         done = 0 if self._observed is None else len(self._observed)
         if self._observed is None or done < len(self.observations):
-            new = self._internal([o.params for o in self.observations[done:]])
+            new = self._points(self.observations[done:])
             points = new if self._observed is None else np.concatenate([self._observed, new])
             points.flags.writeable = False
             self._observed = points

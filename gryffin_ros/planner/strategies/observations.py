@@ -85,4 +85,5 @@ class ObservationReader:
         violated = self.constraints.violated_at(X, clean)
         if violated:
             raise ObservationError(f"parameters {clean} violate the known constraint(s) {violated}")
-        return Observation(clean, values, experiment_id, dict(meta))
+        X.flags.writeable = False
+        return Observation(clean, values, experiment_id, dict(meta), internal=(self.space, X[0]))

@@ -275,3 +275,22 @@ def test_a_candidate_a_fraction_of_a_degree_from_an_observation_is_the_same_expe
         assert select(space, np.array([near, far]), np.array([-10.0, 0.0]), observed, observed[:0], diverse) == 1
         assert select(space, np.array([near, other_solvent]), np.array([-10.0, 0.0]), observed, observed[:0],
                       diverse) == 1
+
+
+def test_an_observation_is_converted_to_the_planners_coordinates_once_when_it_is_accepted(monkeypatch):
+    """tell() validates and converts each observation once; the models read that row (no second conversion), and
+    observations that come without it (read back from a store) are converted when first needed."""
+    from gryffin_ros.planner import Observation
+    config = {"parameters": [{"name": "T", "type": "continuous", "low": 50.0, "high": 100.0},
+                             {"name": "solvent", "type": "categorical", "options": ["a", "b"]}],
+              "objectives": [{"name": "y", "goal": "max"}]}
+    planner = Planner(config, seed=0)
+    planner.tell([{"T": 60.0, "solvent": "b", "y": 1.0}, {"T": 75.0, "solvent": "a", "y": 2.0}])
+    stored = Observation({"T": 100.0, "solvent": "a"}, {"y": 0.5}, "from-a-store")
+    planner.history.add_observations([stored])
+    converted = []
+    real = type(planner.space).to_internal
+    monkeypatch.setattr(type(planner.space), "to_internal",
+                        lambda self, rows: converted.append(len(rows)) or real(self, rows))
+    assert planner.observed_points() == pytest.approx(np.array([[0.2, 1.0], [0.5, 0.0], [1.0, 0.0]]))
+    assert converted == [1]  # only the stored one
