@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import ConfigError, ObservationError
 from ..space import SearchSpace
 from ..suggest import suggestion
-from .expressions import NotLinear, difference, linear_form
+from .expressions import NotLinear, difference, linear_form, parse
 from .named import NamedConstraint
 from .plugins import expression_text
 
@@ -41,7 +41,7 @@ OBSERVATION_TOLERANCE = 1e-6
 
 def _equality_sides(text: str) -> tuple[ast.AST, ast.AST] | None:
     try:
-        tree = ast.parse(text.strip(), mode="eval")
+        tree = parse(text)
     except SyntaxError:
         return None  # the expression evaluator reports syntax errors with its own message
     body = tree.body

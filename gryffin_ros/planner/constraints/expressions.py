@@ -7,6 +7,7 @@ whole columns at once; nothing is ever passed to ``eval``. Anything outside the 
 from __future__ import annotations
 
 import ast
+import functools
 import operator
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any
@@ -41,6 +42,13 @@ _FUNCTIONS: dict[str, tuple[Callable, int, int | None]] = {
 }
 
 
+@functools.lru_cache(maxsize=256)
+def parse(text: str) -> ast.Expression:
+    """The syntax tree of a constraint expression, parsed once per text and shared by its readers (the evaluator,
+    the literal check, the equality and half-space readers), which never change it. Raises SyntaxError."""
+    return ast.parse(text.strip(), mode="eval")
+
+
 class Expression:
     """A compiled constraint expression; ``evaluate(columns)`` returns a boolean array, one entry per row.
 
@@ -55,7 +63,7 @@ class Expression:
         self._names = set(names)
         self._parameters = dict(parameters or {})
         try:
-            tree = ast.parse(text.strip(), mode="eval")
+            tree = parse(text)
         except SyntaxError as exc:
             raise ConfigError(f"constraint {text!r} is not a valid expression: {exc.msg}") from None
         self.variables: set[str] = set()
@@ -245,7 +253,7 @@ def linear_inequalities(text: str, continuous: set[str]) -> list[tuple[dict[str,
     continuous parameters -> half-spaces sum(coefs * x) <= rhs (strict ones taken as non-strict: they differ on a set
     of volume zero); None for anything else."""
     try:
-        body = ast.parse(text.strip(), mode="eval").body
+        body = parse(text).body
     except SyntaxError:
         return None
     parts = body.values if isinstance(body, ast.BoolOp) and isinstance(body.op, ast.And) else [body]

@@ -32,9 +32,12 @@ class KnownConstraints:
     @classmethod
     def build(cls, space: SearchSpace, specs: Sequence[Any] = (),
               callables: Callable | Sequence[Callable] | None = None,
-              parameters: Sequence[Parameter] | None = None) -> KnownConstraints:
+              parameters: Sequence[Parameter] | None = None, first: Sequence[NamedConstraint] = (),
+              complete_columns: Callable[[Mapping[str, np.ndarray]], Mapping[str, np.ndarray]] | None = None,
+              complete_row: Callable[[Mapping[str, Any]], dict] | None = None) -> KnownConstraints:
         """`parameters`: every parameter a constraint may name (default: the space's; a planner adds those solved
-        from equalities)."""
+        from equalities); `first`: constraints checked before the specs' (the solved parameters' bounds);
+        `complete_columns` / `complete_row` as in the constructor."""
         by_name = {p.name: p for p in (space.parameters if parameters is None else parameters)}
         constraints = [constraint_from_spec(s, i, by_name) for i, s in enumerate(specs)]
         continuous = {p.name for p in space.parameters if p.kind == "continuous"}
@@ -48,7 +51,7 @@ class KnownConstraints:
                 if not callable(fn):
                     raise ConfigError(f"known_constraints[{i}] is {type(fn).__name__}, not a callable")
                 constraints.append(callable_constraint(fn, i))
-        return cls(space, constraints)
+        return cls(space, list(first) + constraints, complete_columns, complete_row)
 
     def __bool__(self) -> bool:
         return bool(self.constraints)

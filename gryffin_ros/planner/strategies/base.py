@@ -55,11 +55,12 @@ class BasePlanner:
         self.equalities, specs = LinearEqualities.split(self.config.constraint_specs, full)
         self.space = self.equalities.reduced_space(full) if self.equalities else full
         self.objectives = self.config.objectives
-        self.constraints = KnownConstraints.build(self.space, specs, known_constraints, parameters=full.parameters)
-        if self.equalities:  # the solved parameters' bounds first; every check sees the solved parameters too
-            self.constraints = KnownConstraints(
-                self.space, self.equalities.bound_constraints(full) + self.constraints.constraints,
-                self.equalities.complete_columns, self._complete)
+        # with equalities, the solved parameters' bounds first; every check sees the solved parameters too
+        eq = self.equalities
+        self.constraints = KnownConstraints.build(
+            self.space, specs, known_constraints, parameters=full.parameters,
+            first=eq.bound_constraints(full) if eq else (), complete_columns=eq.complete_columns if eq else None,
+            complete_row=self._complete if eq else None)
         self._known_constraints = known_constraints
         self._reader = ObservationReader(self.space, full, self.equalities, self.objectives, self.constraints)
         if seed is None:

@@ -141,3 +141,24 @@ def test_solvent_blend_example_runs_within_every_limit():
         assert max(p["water"], p["ethanol"], p["dmso"]) <= 0.7 and 0.2 * p["ethanol"] + p["dmso"] <= 0.5
         assert p["T"] <= min(bp for name, bp in boiling.items() if p[name] > 0.01) - 5
         planner.tell({**p, "yield": 50.0 - abs(p["T"] - 60.0), "experiment_id": proposal.experiment_id})
+
+
+def test_each_constraint_expression_is_parsed_once_and_the_known_constraints_built_once(monkeypatch):
+    """An equality and two inequalities: three parses in all (shared by the equality reader, the evaluator, the
+    literal check and the half-space reader), and one KnownConstraints."""
+    import functools
+
+    from gryffin_ros.planner.constraints import equalities, expressions, known
+    parsed, built = [], []
+    real_parse, real_init = expressions.parse.__wrapped__, known.KnownConstraints.__init__
+    counted = functools.lru_cache(maxsize=256)(lambda text: parsed.append(text) or real_parse(text))
+    for module in (expressions, equalities):  # the readers of an expression's tree
+        monkeypatch.setattr(module, "parse", counted)
+    monkeypatch.setattr(known.KnownConstraints, "__init__",
+                        lambda self, *a, **kw: built.append(1) or real_init(self, *a, **kw))
+    config = {"parameters": [{"name": n, "type": "continuous", "low": 0.0, "high": 1.0} for n in "abc"],
+              "objectives": [{"name": "y", "goal": "min"}],
+              "constraints": ["a + b + c == 1", "a <= 0.7 * b + 0.2", "c * c < 0.5"]}
+    Planner(config, seed=0)
+    assert sorted(parsed) == sorted(["a + b + c == 1", "a <= 0.7 * b + 0.2", "c * c < 0.5"])
+    assert built == [1]
