@@ -6,9 +6,12 @@
 - a batch of 96 (a well plate) at n = 500, d = 6, and how spread out it is: the smallest pairwise distance of its
   points (unit cube) against that of 96 random feasible points (median over 20 draws);
 - a Gryffin 1.0 script's loop: stateless `recommend` on a list that grows by one, n = 100 ... 119, d = 2, on one
-  planner (it reuses the fits of the same first observations) and on a fresh planner per call (nothing to reuse).
+  planner (it reuses the fits of the same first observations) and on a fresh planner per call (nothing to reuse);
+- asks on issue #37's mixed Suzuki-like space (3 catalysts, 4 solvents with descriptors, 3 continuous conditions,
+  T below the solvent's boiling point, Chimera yield then cost) at n = 16, 50, 100 (median of 5 warm asks).
 
-    .venv/bin/python benchmarks/lab_scale.py [--surrogate NAME] [--repeats 3] [--out benchmarks/results/lab_scale.md]
+    .venv/bin/python benchmarks/lab_scale.py [--surrogate NAME] [--repeats 3] [--cases warm,...,mixed]
+                                             [--out benchmarks/results/lab_scale.md]
 
 Observations are random feasible points with their objective values, told in one call; "warm" = the planner has
 answered the previous ask and is told its result (what a running campaign does).
@@ -28,6 +31,21 @@ import torch
 from gryffin_ros.planner import Planner
 
 WARM_ASKS = 10
+# issue #37's Suzuki-like campaign: 3 catalysts, 4 solvents with descriptors, 3 continuous conditions, a constraint
+# on a solvent's boiling point, Chimera yield then cost
+MIXED_SIZES, MIXED_ASKS = (16, 50, 100), 5
+SOLVENTS = {"THF": [66.0, 7.5], "dioxane": [101.0, 2.2], "toluene": [111.0, 2.4], "DMF": [153.0, 36.7]}
+MIXED = {
+    "parameters": [{"name": "catalyst", "type": "categorical", "options": ["Pd(PPh3)4", "Pd(dppf)Cl2", "XPhos Pd G3"]},
+                   {"name": "solvent", "type": "categorical", "options": list(SOLVENTS),
+                    "descriptors": SOLVENTS, "descriptor_names": ["boiling_point", "dielectric"]},
+                   {"name": "T", "type": "continuous", "low": 40.0, "high": 150.0},
+                   {"name": "t", "type": "continuous", "low": 0.5, "high": 24.0},
+                   {"name": "loading", "type": "continuous", "low": 0.5, "high": 5.0}],
+    "objectives": [{"name": "yield", "goal": "max", "tolerance": 0.2, "absolute": False},
+                   {"name": "cost", "goal": "min"}],
+    "constraints": ["T < boiling_point(solvent) - 5"],
+}
 
 
 def problem(d: int, surrogate: str | None) -> dict:
@@ -73,22 +91,36 @@ def tell_result(planner: Planner, proposal) -> None:
                   "objectives": {"y": objective(x)}})
 
 
+def mixed_result(p: dict) -> dict:
+    """A smooth synthetic yield with a best catalyst-solvent pair, and a cost of catalyst loading and time."""
+    cat = ["Pd(PPh3)4", "Pd(dppf)Cl2", "XPhos Pd G3"].index(p["catalyst"])
+    sol = list(SOLVENTS).index(p["solvent"])
+    y = (0.4 + 0.2 * cat + 0.1 * sol) * np.exp(-((p["T"] - 95.0) / 40.0) ** 2) * (1 - np.exp(-p["t"] / 4.0))
+    cost = p["loading"] * (1 + 0.2 * cat) + 0.1 * p["t"]
+    return {"yield": float(y * min(1.0, p["loading"] / 2.0)), "cost": float(cost)}
+
+
+def mixed_planner(n: int, surrogate: str | None, seed: int) -> Planner:
+    config = dict(MIXED, general={"surrogate": surrogate} if surrogate else {})
+    planner = Planner(config, seed=seed)
+    rng = np.random.default_rng(seed)
+    rows = []
+    while len(rows) < n:
+        p = {"catalyst": str(rng.choice(MIXED["parameters"][0]["options"])), "solvent": str(rng.choice(list(SOLVENTS))),
+             "T": float(rng.uniform(40, 150)), "t": float(rng.uniform(0.5, 24)), "loading": float(rng.uniform(0.5, 5))}
+        if p["T"] < SOLVENTS[p["solvent"]][0] - 5:
+            rows.append({"params": p, "objectives": mixed_result(p)})
+    planner.tell(rows)
+    return planner
+
+
 def min_distance(points: np.ndarray) -> float:
     diff = points[:, None, :] - points[None, :, :]
     dist = np.sqrt((diff ** 2).sum(-1))
     return float(dist[np.triu_indices(len(points), 1)].min())
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--surrogate", default=None, help="general.surrogate (default: the planner's default)")
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--out", default=None)
-    a = ap.parse_args()
-    torch.set_num_threads(1)
-    label = a.surrogate or "default"
-    rows = []
-
+def case_warm(a, rows: list, notes: list) -> None:
     first, warm, slowest, meta = [], [], [], []
     for seed in range(a.repeats):
         planner, _ = planner_with(995, 10, a.surrogate, seed)
@@ -107,7 +139,10 @@ def main() -> None:
     rows.append((f"warm ask, n = 996–1005, d = 10 (median of {WARM_ASKS} asks)", "≤ 1 s", statistics.median(warm)))
     rows.append(("slowest of those (the one that refits the hyperparameters)", "—", statistics.median(slowest)))
     rows.append(("first ask, n = 995, d = 10", "≤ 5 s", statistics.median(first)))
+    notes.append("Proposal meta at n = 1000: " + "; ".join(str(m) for m in meta))
 
+
+def case_batch8(a, rows: list, notes: list) -> None:
     batch8 = []
     for seed in range(a.repeats):
         planner, _ = planner_with(200, 6, a.surrogate, seed)
@@ -117,6 +152,8 @@ def main() -> None:
         print(f"batch of 8, n=200 d=6 seed {seed}: {t:.2f} s", flush=True)
     rows.append(("batch of 8, n = 200, d = 6", "≤ 1.5 s", statistics.median(batch8)))
 
+
+def case_batch96(a, rows: list, notes: list) -> None:
     batch96, spread = [], []
     for seed in range(a.repeats):
         planner, rng = planner_with(500, 6, a.surrogate, seed)
@@ -129,7 +166,11 @@ def main() -> None:
         print(f"batch of 96, n=500 d=6 seed {seed}: {t:.2f} s, min distance {spread[-1][0]:.3f} "
               f"(random feasible {random_spread:.3f})", flush=True)
     rows.append(("batch of 96, n = 500, d = 6", "≤ 15 s", statistics.median(batch96)))
+    notes.append("Batch of 96: smallest pairwise distance of the proposals (unit cube) vs 96 random feasible points "
+                 "(median of 20 draws): " + "; ".join(f"{ours:.3f} vs {rand:.3f}" for ours, rand in spread))
 
+
+def case_stateless(a, rows: list, notes: list) -> None:
     loop, fresh = [], []
     for seed in range(a.repeats):
         rng = np.random.default_rng(seed)
@@ -154,12 +195,50 @@ def main() -> None:
     rows.append(("stateless recommend on a fresh planner, n = 100, d = 2 (fit and feasible-region estimate anew)",
                  "—", statistics.median(fresh)))
 
+
+def case_mixed(a, rows: list, notes: list) -> None:
+    for n in MIXED_SIZES:
+        medians = []
+        for seed in range(a.repeats):
+            planner = mixed_planner(n, a.surrogate, seed)
+            planner.ask(1)  # warm: this campaign's fit exists
+            times = []
+            for _ in range(MIXED_ASKS):
+                t, (proposal,) = timed_ask(planner, 1)
+                times.append(t)
+                planner.tell({"experiment_id": proposal.experiment_id, "params": proposal.params,
+                              "objectives": mixed_result(proposal.params)})
+            medians.append(statistics.median(times))
+            print(f"mixed n={n} seed {seed}: median {medians[-1]:.2f} s ({proposal.meta.get('surrogate')})",
+                  flush=True)
+        rows.append((f"mixed Suzuki-like space, n = {n} (median of {MIXED_ASKS} warm asks)", "≤ 1 s",
+                     statistics.median(medians)))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--surrogate", default=None, help="general.surrogate (default: the planner's default)")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--cases", default="warm,batch8,batch96,stateless,mixed",
+                    help="comma-separated: warm, batch8, batch96, stateless, mixed")
+    a = ap.parse_args()
+    torch.set_num_threads(1)
+    label = a.surrogate or "default"
+
+    cases = {"warm": case_warm, "batch8": case_batch8, "batch96": case_batch96, "stateless": case_stateless,
+             "mixed": case_mixed}
+    rows: list = []
+    notes: list = []
+    for name in a.cases.split(","):
+        if name not in cases:
+            raise SystemExit(f"unknown case {name!r}; cases are {sorted(cases)}")
+        cases[name](a, rows, notes)
+
     lines = [f"Lab-scale ask CPU time, surrogate {label} (median of {a.repeats}; one thread; "
              f"{os.cpu_count()} cores here)", "", "| case | target | CPU s |", "|---|---|---|"]
     lines += [f"| {case} | {target} | {value:.2f} |" for case, target, value in rows]
-    lines += ["", "Batch of 96: smallest pairwise distance of the proposals (unit cube) vs 96 random feasible "
-              "points (median of 20 draws): " + "; ".join(f"{ours:.3f} vs {rand:.3f}" for ours, rand in spread),
-              "", "Proposal meta at n = 1000: " + "; ".join(str(m) for m in meta)]
+    lines += [line for note in notes for line in ("", note)]
     text = "\n".join(lines) + "\n"
     print(text)
     if a.out:
