@@ -9,7 +9,7 @@ PYTHON ?= python3
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 LOCK := requirements.lock
-EXTRAS := .[test,ros,interfaces,workspace]
+EXTRAS := .[test,ros,interfaces,workspace,record]
 MSGS := $(VENV)/.interfaces
 
 # DDS stays on loopback in every process started from here (SPEC section 6), with the fast-discovery profile.

@@ -54,6 +54,9 @@ setup(
         # extensions that build ament_cmake and ament_python packages and write install/setup.bash
         "workspace": ["colcon-core", "colcon-ros", "colcon-cmake", "colcon-python-setup-py", "colcon-bash",
                       "colcon-library-path", "colcon-package-selection", "colcon-parallel-executor", "colcon-output"],
+        # the planner node's `record` parameter writes MCAP (rosbag2 layout); rosbags reads bags back (the tests,
+        # gryffin-ros import)
+        "record": ["mcap>=1.1", "rosbags>=0.10"],
         # kept so that `pip install gryffin_ros[gp]` of earlier instructions still works; BoTorch is a dependency now
         "gp": [],
     },

@@ -28,6 +28,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     run.add_argument("--noise", action="store_true", help="redox emulator: add the published noise to DFT values")
     run.add_argument("--dashboard", type=int, default=None, metavar="PORT",
                      help="serve the campaign's live page on this port of 127.0.0.1 while it runs (0: any free port)")
+    run.add_argument("--record", action="store_true",
+                     help="record the planner node's messages into a ROS 2 bag <out>/bag (rosbag2 layout, MCAP; "
+                          "docs/ros.md, Recording a campaign)")
     run.set_defaults(handler=campaign)
     exp = sub.add_parser("export", help="write a campaign store's experiments as CSV and/or JSON (default: both, "
                                         "next to the store)")
