@@ -11,6 +11,7 @@ reports the node in every state.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
@@ -30,7 +31,7 @@ from .outputs import Outputs
 from .parameters import PARAMETERS, READ_ONLY, check_parameter, settings
 from .qos import DIAGNOSTICS_QOS, OBSERVATIONS_SUBSCRIPTION_QOS, SERVICES_QOS
 from .recommend import Asks
-from .recorder import BagRecorder
+from .recorder import CONFIG_DIR_KEY, CONFIG_KEY, SEED_KEY, BagRecorder
 from .runner import declare, run
 from .typed import GetStatus, Recommend
 from .web import start_dashboard
@@ -87,7 +88,10 @@ class PlannerNode(LifecycleNode):
                 self.dashboard = start_dashboard(storage, p["dashboard_host"], p["dashboard_port"], p["config"],
                                                  self.get_logger())
             # every typed message sent or received, into a bag (docs/ros.md, "Recording a campaign")
-            self.recorder = BagRecorder(p["record"]) if p["record"] else None
+            if p["record"]:  # with what `gryffin-ros import` needs to make a store of the bag again
+                self.recorder = BagRecorder(p["record"], custom_data={
+                    CONFIG_KEY: campaign.store.get_meta("config") or "", SEED_KEY: str(campaign.seed),
+                    CONFIG_DIR_KEY: str(Path(p["config"]).resolve().parent)})
         except BaseException:
             if self.dashboard is not None:
                 self.dashboard.close()

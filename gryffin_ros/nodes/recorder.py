@@ -29,6 +29,8 @@ from rclpy.serialization import serialize_message
 
 from ..planner import GryffinRosError
 
+# metadata.yaml custom_data keys of a planner's bag (`gryffin-ros import` reads them)
+CONFIG_KEY, CONFIG_DIR_KEY, SEED_KEY = "gryffin_ros.config", "gryffin_ros.config_dir", "gryffin_ros.seed"
 SEGMENT_MESSAGES = 2000
 FLUSH_S = 1.0
 BAG_VERSION = 9
@@ -143,7 +145,8 @@ class _Segment:
 class BagRecorder:
     """Records messages into the bag folder `path` (which must not exist yet); `close` finishes it."""
 
-    def __init__(self, path: str | os.PathLike, flush_s: float = FLUSH_S, segment_messages: int = SEGMENT_MESSAGES):
+    def __init__(self, path: str | os.PathLike, flush_s: float = FLUSH_S, segment_messages: int = SEGMENT_MESSAGES,
+                 custom_data: dict[str, str] | None = None):
         try:
             import mcap.writer  # noqa: F401 - the `record` extra
         except ImportError as exc:
@@ -157,6 +160,8 @@ class BagRecorder:
             raise GryffinRosError(f"record: the folder {self.path.parent} does not exist")
         self.path.mkdir()
         self._segment_messages = segment_messages
+        # metadata.yaml's custom_data (strings): the planner keeps its config there, so a bag can become a store
+        self._custom_data = {"recorded_by": "gryffin_ros planner_node", **(custom_data or {})}
         self._topics: dict[str, _Topic] = {}
         self._sealed: list[_Segment] = []
         self._segment = self._new_segment()
@@ -256,7 +261,7 @@ class BagRecorder:
             "files": [{"path": s.path.name, "starting_time": {"nanoseconds_since_epoch": s.start_ns or 0},
                        "duration": {"nanoseconds": max(0, s.end_ns - (s.start_ns or 0))},
                        "message_count": len(s.messages)} for s in segments],
-            "custom_data": {"recorded_by": "gryffin_ros planner_node"},
+            "custom_data": self._custom_data,
             "ros_distro": "jazzy",
         }
         tmp = self.path / "metadata.yaml.tmp"

@@ -6,18 +6,49 @@ bag."""
 from __future__ import annotations
 
 import signal
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import yaml
 
 from gryffin_ros.storage import CampaignStore
 
 from ..bags import as_store, read_bag
-from .conftest import HANG_S
+from .conftest import FLOW_CONFIG, HANG_S
 from .test_typed import lab, observation_of, wait_until  # noqa: F401 - lab is a fixture
 
 NODE = "/gryffin_planner"
 OBJECTIVES = ("X1_X2",)
+
+
+def observations_of(path: Path) -> list[tuple[str, dict, dict]]:
+    store = CampaignStore.open_existing(path)
+    try:
+        return [(o.experiment_id, o.params, o.objectives) for o in store.observations()]
+    finally:
+        store.close()
+
+
+def config_of(path: Path) -> dict:
+    store = CampaignStore.open_existing(path)
+    try:
+        return store.config
+    finally:
+        store.close()
+
+
+def gryffin_ros(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "gryffin_ros.cli", *args], capture_output=True, text=True,
+                          timeout=HANG_S)
+
+
+def test_the_bag_keys_are_the_importers():
+    from gryffin_ros.cli import bag_import
+    from gryffin_ros.nodes import recorder
+    assert (recorder.CONFIG_KEY, recorder.CONFIG_DIR_KEY, recorder.SEED_KEY) == (
+        bag_import.CONFIG_KEY, bag_import.CONFIG_DIR_KEY, bag_import.SEED_KEY)
 
 
 def test_a_recorded_campaign_reads_back_with_rosbags_and_matches_the_store(lab, start_planner, tmp_path):  # noqa: F811
@@ -55,14 +86,30 @@ def test_a_recorded_campaign_reads_back_with_rosbags_and_matches_the_store(lab, 
     assert judged == [(e.type, e.experiment_id) for e in events]
     accepted = [as_store(m, OBJECTIVES) for m, (kind, _) in zip(received, judged) if kind == "observation_accepted"]
 
-    store = CampaignStore.open_existing(tmp_path / "campaign.sqlite")
-    try:
-        stored = [(o.experiment_id, o.params, o.objectives) for o in store.observations()]
-    finally:
-        store.close()
+    stored = observations_of(tmp_path / "campaign.sqlite")
     assert accepted == stored
     last_status = [m for topic, _, _, m in messages if topic == f"{NODE}/status"][-1]
     assert (last_status.n_observations, last_status.n_failed) == (3, 1)
+
+    # back to a campaign: `gryffin-ros import` rebuilds the store from the bag alone (config and seed in its metadata)
+    imported = tmp_path / "imported.sqlite"
+    result = gryffin_ros("import", str(bag), "--out", str(imported))
+    assert result.returncode == 0, result.stderr
+    assert observations_of(imported) == stored
+    assert config_of(imported) == config_of(tmp_path / "campaign.sqlite")
+    # a bag without the config (recorded by something else) needs --config, and says so
+    metadata_path = bag / "metadata.yaml"
+    metadata = yaml.safe_load(metadata_path.read_text())
+    metadata["rosbag2_bagfile_information"]["custom_data"] = None
+    metadata_path.write_text(yaml.safe_dump(metadata))
+    refused = gryffin_ros("import", str(bag), "--out", str(tmp_path / "again.sqlite"))
+    assert refused.returncode == 2 and "give it with --config" in refused.stderr
+    assert not (tmp_path / "again.sqlite").exists()
+    config = tmp_path / "config.yaml"
+    config.write_text(yaml.safe_dump(FLOW_CONFIG))
+    again = gryffin_ros("import", str(bag), "--out", str(tmp_path / "again.sqlite"), "--config", str(config))
+    assert again.returncode == 0, again.stderr
+    assert observations_of(tmp_path / "again.sqlite") == stored
 
 
 def test_a_killed_node_leaves_a_complete_bag(lab, start_planner, tmp_path):  # noqa: F811
