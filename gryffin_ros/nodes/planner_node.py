@@ -37,6 +37,9 @@ from .typed import GetStatus, Recommend
 from .web import start_dashboard
 
 DIAGNOSTICS_PERIOD_S = 1.0
+# what the node records with `record`: its typed outputs and both kinds of observation input
+RECORDED_TYPES = ("gryffin_ros_msgs/msg/Proposals", "gryffin_ros_msgs/msg/Event",
+                  "gryffin_ros_msgs/msg/CampaignStatus", "gryffin_ros_msgs/msg/Observation", "std_msgs/msg/String")
 DEACTIVATED = "the planner was deactivated while recommending; nothing was proposed"
 SHUTTING_DOWN = "the planner is shutting down; nothing was proposed (ask again when it is back)"
 
@@ -91,7 +94,7 @@ class PlannerNode(LifecycleNode):
             if p["record"]:  # with what `gryffin-ros import` needs to make a store of the bag again
                 self.recorder = BagRecorder(p["record"], custom_data={
                     CONFIG_KEY: campaign.store.get_meta("config") or "", SEED_KEY: str(campaign.seed),
-                    CONFIG_DIR_KEY: str(Path(p["config"]).resolve().parent)})
+                    CONFIG_DIR_KEY: str(Path(p["config"]).resolve().parent)}, types=RECORDED_TYPES)
         except BaseException:
             if self.dashboard is not None:
                 self.dashboard.close()

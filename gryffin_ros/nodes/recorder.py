@@ -146,13 +146,15 @@ class BagRecorder:
     """Records messages into the bag folder `path` (which must not exist yet); `close` finishes it."""
 
     def __init__(self, path: str | os.PathLike, flush_s: float = FLUSH_S, segment_messages: int = SEGMENT_MESSAGES,
-                 custom_data: dict[str, str] | None = None):
+                 custom_data: dict[str, str] | None = None, types: tuple[str, ...] = ()):
         try:
             import mcap.writer  # noqa: F401 - the `record` extra
         except ImportError as exc:
             raise GryffinRosError("recording needs the 'mcap' package: install gryffin_ros with its 'record' "
                                   "extra") from exc
         self.path = Path(path)
+        # the schemas of the types to be recorded, looked up now: a missing definition fails here, not mid-campaign
+        self._definitions = {name: (message_definition(name), type_hash(name)) for name in types}
         if self.path.exists():
             raise GryffinRosError(f"record: {self.path} already exists (a bag is never overwritten; name a new "
                                   "folder)")
@@ -164,6 +166,7 @@ class BagRecorder:
         self._custom_data = {"recorded_by": "gryffin_ros planner_node", **(custom_data or {})}
         self._topics: dict[str, _Topic] = {}
         self._sealed: list[_Segment] = []
+        self._failure: str | None = None
         self._segment = self._new_segment()
         self._lock = threading.Lock()
         self._dirty = True
@@ -174,7 +177,7 @@ class BagRecorder:
         self._thread.start()
 
     def _new_segment(self) -> _Segment:
-        return _Segment(self.path / f"{self.path.name}_{len(getattr(self, '_sealed', []))}.mcap")
+        return _Segment(self.path / f"{self.path.name}_{len(self._sealed)}.mcap")
 
     def record(self, topic: str, msg: Any, qos: QoSProfile, receive_ns: int | None = None) -> None:
         """Keep `msg` as sent or received on `topic` (its resolved name) now or at `receive_ns`."""
@@ -185,7 +188,9 @@ class BagRecorder:
         with self._lock:
             if topic not in self._topics:
                 name = type_name(msg)
-                self._topics[topic] = _Topic(topic, name, qos_yaml(qos), message_definition(name), type_hash(name))
+                if name not in self._definitions:
+                    self._definitions[name] = (message_definition(name), type_hash(name))
+                self._topics[topic] = _Topic(topic, name, qos_yaml(qos), *self._definitions[name])
             self._topics[topic].count += 1
             segment = self._segment
             segment.messages.append((topic, stamp, data))
@@ -199,7 +204,15 @@ class BagRecorder:
 
     def _flusher(self) -> None:
         while not self._closed.wait(self._flush_s):
-            self.flush()
+            try:
+                self.flush()
+            except Exception as exc:  # noqa: BLE001 - a full disk: said once, tried again each second
+                if self._failure is None:
+                    print(f"record: writing {self.path} failed ({exc!r}); retrying every {self._flush_s} s",
+                          file=sys.stderr, flush=True)
+                self._failure = repr(exc)
+            else:
+                self._failure = None
 
     def flush(self) -> None:
         with self._lock:
