@@ -23,7 +23,9 @@ setup(
         (f"share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/msg_schemas", [str(p) for p in Path("msg_schemas").glob("*.json")]),
-        (f"share/{PACKAGE}/examples", [str(p) for p in Path("examples").glob("*.yaml")]),
+        # the example campaigns with the data files they name, and the --params-file examples/planner_params.yaml
+        (f"share/{PACKAGE}/examples",
+         sorted(str(p) for p in Path("examples").glob("*") if p.suffix in (".yaml", ".csv"))),
     ],
     install_requires=[
         "numpy>=1.24",
@@ -48,6 +50,13 @@ setup(
                        "ros-jazzy-ament-cmake", "ros-jazzy-ament-cmake-include-directories", "ros-jazzy-ament-cmake-ros",
                        "ros-jazzy-ament-cmake-gmock", "ros-jazzy-ament-cmake-gtest", "ros-jazzy-ament-cmake-pytest",
                        "ros-jazzy-python-cmake-module", "ros-jazzy-ament-package", "catkin_pkg"],
+        # a colcon workspace with this repository under src/ (README, "In a colcon workspace"): colcon and the
+        # extensions that build ament_cmake and ament_python packages and write install/setup.bash
+        "workspace": ["colcon-core", "colcon-ros", "colcon-cmake", "colcon-python-setup-py", "colcon-bash",
+                      "colcon-library-path", "colcon-package-selection", "colcon-parallel-executor", "colcon-output"],
+        # the planner node's `record` parameter writes MCAP (rosbag2 layout); rosbags reads bags back (the tests,
+        # gryffin-ros import)
+        "record": ["mcap>=1.1", "rosbags>=0.10"],
         # kept so that `pip install gryffin_ros[gp]` of earlier instructions still works; BoTorch is a dependency now
         "gp": [],
     },

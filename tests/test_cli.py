@@ -12,6 +12,8 @@ import pytest
 from gryffin_ros.nodes.rosenv import ros_environment
 from gryffin_ros.storage import CampaignStore
 
+from .bags import as_store, judged_observations, read_bag
+
 # Deadlines only catch hangs: many times what a step takes on a busy 2-core machine (the 12-experiment campaign over
 # ROS below takes about 20 s there, Ctrl-C to exit a few), so a slow machine waits longer but never fails.
 HANG_S = 600
@@ -39,7 +41,7 @@ def gryffin_ros(*args, timeout=HANG_S):
 @pytest.mark.ros
 def test_closed_loop_campaign_over_ros(tmp_path):
     out = tmp_path / "run"
-    result = gryffin_ros("campaign", "--budget", "12", "--seed", "4", "--out", str(out))
+    result = gryffin_ros("campaign", "--budget", "12", "--seed", "4", "--out", str(out), "--record")
     assert result.returncode == 0, result.stdout + result.stderr
     done = [int(n) for n in re.findall(r"(\d+)/12 experiments", result.stdout)]
     assert done and done[-1] >= 12
@@ -53,6 +55,17 @@ def test_closed_loop_campaign_over_ros(tmp_path):
     export = gryffin_ros("export", str(out / "campaign.sqlite"), "--json", str(tmp_path / "all.json"))
     assert export.returncode == 0, export.stderr
     assert len(json.loads((tmp_path / "all.json").read_text())["observations"]) == len(rows)
+
+    # --record: the planner node's bag, read by rosbags; its accepted observations are the store's
+    messages = read_bag(out / "bag")
+    judged = judged_observations(messages)
+    accepted = [as_store(m, ("X1_X2", "cost")) for m, event in judged if event == "observation_accepted"]
+    kept = [(o.experiment_id, o.params, o.objectives) for o in observations]
+    assert accepted == kept[:len(accepted)] and len(accepted) >= 12
+    # what the node stored as it stopped, after its events were no longer sent, was received all the same
+    received = [as_store(m, ("X1_X2", "cost")) for topic, _, _, m in messages
+                if topic == "/gryffin_planner/observations"]
+    assert all(o in received for o in kept[len(accepted):])
 
 
 @pytest.fixture(scope="module")
@@ -96,3 +109,8 @@ def test_dashboard_command_serves_a_store_until_ctrl_c(api_campaign, tmp_path):
     missing = gryffin_ros("dashboard", str(tmp_path / "nothing.sqlite"))
     assert missing.returncode == 2 and "no campaign store" in missing.stderr
 
+
+
+def test_record_without_the_nodes_is_refused_with_the_reason():
+    result = gryffin_ros("campaign", "--no-ros", "--record", "--budget", "1")
+    assert result.returncode == 2 and "--record records the planner node's messages" in result.stderr

@@ -76,6 +76,11 @@ def run_ros(config_path: str, config: PlannerConfig, store_path: Path, args: arg
     seed = -1 if seed is None else seed
     planner_cmd = [sys.executable, "-m", "gryffin_ros.nodes.planner_node", "--ros-args",
                    "-p", f"config:={config_path}", "-p", f"storage:={store_path}", "-p", f"seed:={seed}"]
+    if args.record:  # a bag is never overwritten: a continued campaign records into the next free name
+        bag = next(out / name for name in ("bag", *(f"bag_{k}" for k in range(1, 10**6)))
+                   if not (out / name).exists())
+        planner_cmd += ["-p", f"record:={bag}"]
+        print(f"recording: {bag}", flush=True)
     emulator_cmd = [sys.executable, "-m", "gryffin_ros.nodes.emulator_node", kind, "--ros-args",
                     "-p", f"seed:={seed}", "-p", f"experiment_time_s:={args.experiment_time}",
                     "-p", f"objectives:=[{','.join(objectives)}]"]
@@ -157,6 +162,8 @@ def run_campaign(config_path: str, config: PlannerConfig, args: argparse.Namespa
 
 
 def campaign(args: argparse.Namespace) -> int:
+    if args.record and args.no_ros:
+        raise GryffinRosError("--record records the planner node's messages: it needs the nodes (leave out --no-ros)")
     config_path = str(Path(args.config).resolve()) if args.config else str(share_path("examples") / "flow_reactor.yaml")
     config = load_config(config_path)
     emulator_settings(config)  # fail before starting anything when no emulator fits

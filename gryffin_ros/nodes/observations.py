@@ -1,6 +1,8 @@
 """Observations arriving at the planner node, typed or as JSON, handed to the campaign one by one: each accepted
 one is announced (`observation_accepted`) and wakes auto-propose; each refused one is announced with the reason
-and recorded in the campaign's store, with its experiment_id whenever the message names one."""
+and recorded in the campaign's store, with its experiment_id whenever the message names one. With a `record`
+callback, each message is handed to it as received, before it is judged (the bag shows accept or reject in the
+events that follow it)."""
 
 from __future__ import annotations
 
@@ -19,11 +21,15 @@ from .outputs import Outputs
 
 class ObservationInput:
     def __init__(self, campaign: Campaign, outputs: Outputs, accepted: Callable[[], None],
-                 max_message_bytes: Callable[[], int], logger: Any):
+                 max_message_bytes: Callable[[], int], logger: Any,
+                 record: Callable[[str, Any], None] | None = None):
         self._campaign, self._outputs, self._accepted = campaign, outputs, accepted
         self._max_bytes, self._logger = max_message_bytes, logger
+        self._record = record  # (which input: "typed" or "json", the message)
 
     def on_typed(self, msg: typed.Observation) -> None:
+        if self._record is not None:
+            self._record("typed", msg)
         raw = typed.observation_record(msg)
         try:
             item = typed.observation_item(msg)
@@ -33,6 +39,8 @@ class ObservationInput:
         self._take([item], lambda _item: raw)
 
     def on_json(self, msg: String) -> None:
+        if self._record is not None:
+            self._record("json", msg)
         try:
             items = messages.observation_items(messages.parse("observation", msg.data, self._max_bytes()))
         except GryffinRosError as exc:  # the id, when the refused message names one (schema errors)

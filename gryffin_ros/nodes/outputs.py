@@ -15,18 +15,22 @@ from ..campaign import Campaign
 from ..planner import Proposal
 from . import typed
 from .qos import EVENTS_QOS, LATCHED_QOS
+from .recorder import BagRecorder
 from .typed import GetStatus
+
+QOS = {"proposals": LATCHED_QOS, "events": EVENTS_QOS, "status": LATCHED_QOS}
 
 
 class Outputs:
     def __init__(self, node: LifecycleNode, campaign: Campaign, open_: Callable[[], bool],
-                 closing: Callable[[], bool]):
+                 closing: Callable[[], bool], recorder: BagRecorder | None = None):
         self._node, self._campaign, self._open, self._closing = node, campaign, open_, closing
+        self._recorder = recorder  # the typed messages sent are recorded as sent (node parameter `record`)
         make = node.create_lifecycle_publisher
         self._publishers = {
-            "proposals": make(typed.Proposals, "~/proposals", LATCHED_QOS),
-            "events": make(typed.Event, "~/events", EVENTS_QOS),
-            "status": make(typed.CampaignStatus, "~/status", LATCHED_QOS),
+            "proposals": make(typed.Proposals, "~/proposals", QOS["proposals"]),
+            "events": make(typed.Event, "~/events", QOS["events"]),
+            "status": make(typed.CampaignStatus, "~/status", QOS["status"]),
             "json/proposals": make(String, "~/json/proposals", LATCHED_QOS),
             "json/events": make(String, "~/json/events", EVENTS_QOS),
             "json/status": make(String, "~/json/status", LATCHED_QOS),
@@ -46,6 +50,9 @@ class Outputs:
         except Exception:  # noqa: BLE001 - shutdown or deactivation began while this callback was running
             if self._open() and not self._closing():
                 raise
+            return
+        if self._recorder is not None and name in QOS:
+            self._recorder.record(publisher.topic_name, msg, QOS[name])
 
     def proposals(self, proposals: list[Proposal]) -> None:
         name, n = self._campaign.name, self._campaign.n_observations

@@ -19,8 +19,10 @@ PARAMETERS = {
     "max_message_bytes": (messages.MAX_MESSAGE_BYTES, "larger incoming JSON messages are refused unparsed"),
     "dashboard_port": (-1, "serve the campaign's live web page on this port (0: any free port; -1: none)"),
     "dashboard_host": ("127.0.0.1", "address the web page binds to (default: this machine only)"),
+    "record": ("", "record every typed message the planner publishes or receives into this new bag folder (rosbag2 "
+                   "layout, MCAP); empty: off; read-only"),
 }
-READ_ONLY = ("config", "storage", "seed", "autostart")
+READ_ONLY = ("config", "storage", "seed", "autostart", "record")
 
 
 def check_parameter(name: str, value: Any) -> str | None:

@@ -11,6 +11,7 @@ reports the node in every state.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
@@ -30,11 +31,15 @@ from .outputs import Outputs
 from .parameters import PARAMETERS, READ_ONLY, check_parameter, settings
 from .qos import DIAGNOSTICS_QOS, OBSERVATIONS_SUBSCRIPTION_QOS, SERVICES_QOS
 from .recommend import Asks
+from .recorder import CONFIG_DIR_KEY, CONFIG_KEY, SEED_KEY, BagRecorder
 from .runner import declare, run
 from .typed import GetStatus, Recommend
 from .web import start_dashboard
 
 DIAGNOSTICS_PERIOD_S = 1.0
+# what the node records with `record`: its typed outputs and both kinds of observation input
+RECORDED_TYPES = ("gryffin_ros_msgs/msg/Proposals", "gryffin_ros_msgs/msg/Event",
+                  "gryffin_ros_msgs/msg/CampaignStatus", "gryffin_ros_msgs/msg/Observation", "std_msgs/msg/String")
 DEACTIVATED = "the planner was deactivated while recommending; nothing was proposed"
 SHUTTING_DOWN = "the planner is shutting down; nothing was proposed (ask again when it is back)"
 
@@ -58,6 +63,7 @@ class PlannerNode(LifecycleNode):
         self._inputs: list = []  # (destroy, entity) of the active state: subscriptions, services, timer, guard
         self.outputs: Outputs | None = None
         self.observations: ObservationInput | None = None
+        self.recorder: BagRecorder | None = None
         self.asks: Asks | None = None
         self.add_on_set_parameters_callback(self._on_set_parameters)
         # always there, in every state: a lifecycle manager and an operator see why a node is not running
@@ -84,7 +90,15 @@ class PlannerNode(LifecycleNode):
             if p["dashboard_port"] >= 0:
                 self.dashboard = start_dashboard(storage, p["dashboard_host"], p["dashboard_port"], p["config"],
                                                  self.get_logger())
+            # every typed message sent or received, into a bag (docs/ros.md, "Recording a campaign")
+            if p["record"]:  # with what `gryffin-ros import` needs to make a store of the bag again
+                self.recorder = BagRecorder(p["record"], custom_data={
+                    CONFIG_KEY: campaign.store.get_meta("config") or "", SEED_KEY: str(campaign.seed),
+                    CONFIG_DIR_KEY: str(Path(p["config"]).resolve().parent)}, types=RECORDED_TYPES)
         except BaseException:
+            if self.dashboard is not None:
+                self.dashboard.close()
+                self.dashboard = None
             campaign.close()
             raise
         self.campaign, self.storage = campaign, storage
@@ -92,9 +106,10 @@ class PlannerNode(LifecycleNode):
             self.get_logger().warning(text)
         # the action lives until cleanup (goals are refused while inactive): a result in flight when the node is
         # deactivated still reaches its client
-        self.outputs = Outputs(self, campaign, lambda: self._active and not self._closing, lambda: self._closing)
+        self.outputs = Outputs(self, campaign, lambda: self._active and not self._closing, lambda: self._closing,
+                               self.recorder)
         self.observations = ObservationInput(campaign, self.outputs, self._wake, lambda: self.p["max_message_bytes"],
-                                             self.get_logger())
+                                             self.get_logger(), self._record_input if self.recorder else None)
         self.asks = Asks(campaign, self.outputs, lambda: self.p["batch_size"])
         self._action = ActionServer(self, Recommend, "~/recommend", execute_callback=self.asks.execute_recommend,
                                     goal_callback=self._on_goal, cancel_callback=lambda _goal: CancelResponse.ACCEPT,
@@ -103,6 +118,10 @@ class PlannerNode(LifecycleNode):
             f"campaign '{campaign.name}' in {storage}: {campaign.n_observations} observation(s), "
             f"{len(campaign.pending)} pending; feasible fraction {fraction.value:.3g} ({fraction.method}); seed "
             f"{campaign.seed}; acquisition optimizer {campaign.config.general.acquisition_optimizer}")
+
+    def _record_input(self, kind: str, msg) -> None:
+        topic = self.resolve_topic_name("~/observations" if kind == "typed" else "~/json/observations")
+        self.recorder.record(topic, msg, OBSERVATIONS_SUBSCRIPTION_QOS)
 
     def on_configure(self, state) -> TransitionCallbackReturn:
         try:
@@ -188,6 +207,9 @@ class PlannerNode(LifecycleNode):
         if self.campaign is not None:
             self.campaign.close()
             self.campaign = None
+        if self.recorder is not None:
+            self.recorder.close()
+            self.recorder = None
 
     def begin_shutdown(self) -> None:
         """Stop publishing and auto-proposing (observations arriving meanwhile are still stored, until close), and
