@@ -50,6 +50,8 @@ setup(
                        "ros-jazzy-python-cmake-module", "ros-jazzy-ament-package", "catkin_pkg"],
         # kept so that `pip install gryffin_ros[gp]` of earlier instructions still works; BoTorch is a dependency now
         "gp": [],
+        # SMILES options of categorical parameters: descriptors, structure constraints and drawings (RDKit)
+        "molecules": ["rdkit>=2023.9"],
     },
     entry_points={
         "console_scripts": [
