@@ -253,3 +253,13 @@ def compute(name: str, smiles: Mapping[str, str], columns: tuple[str, ...], patt
     properties = {p: {o: cache[(s, p)] for o, s in smiles.items()} for p in CATALOG}
     substructures = {p: {o: cache[(s, f"smarts:{p}")] > 0.5 for o, s in smiles.items()} for p in patterns}
     return Molecules(dict(smiles), columns, properties, substructures)
+
+
+def draw_svg(smiles: str, width: int = 220, height: int = 160) -> str:
+    """A 2D drawing of a molecule as SVG text (RDKit's depiction)."""
+    mol = parse_smiles(smiles, "drawing a molecule")  # a ConfigError naming the extra without RDKit
+    from rdkit.Chem.Draw import rdMolDraw2D
+    drawer = rdMolDraw2D.MolDraw2DSVG(width, height)
+    drawer.DrawMolecule(mol)
+    drawer.FinishDrawing()
+    return drawer.GetDrawingText()

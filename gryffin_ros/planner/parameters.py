@@ -206,9 +206,23 @@ def parameter_from_spec(spec: Mapping[str, Any], position: int, molecules: Molec
     computed = np.array([[molecules.properties[c][o] for c in molecules.columns] for o in options]).reshape(
         len(options), len(molecules.columns))
     matrix = computed if given is None else np.hstack([given, computed])
+    if matrix.shape[1]:
+        _warn_alike(where, options, matrix)
     return CategoricalParameter(name, tuple(options), _rescaled(matrix) if matrix.shape[1] else None,
                                 {**(named or {}), **molecules.properties}, dict(molecules.smiles),
                                 molecules.substructures)
+
+
+def _warn_alike(where: str, options: Sequence[str], matrix: np.ndarray) -> None:
+    """Warn about molecules whose descriptors are all equal (isomers, often): the models cannot tell them apart."""
+    groups: dict[tuple, list[str]] = {}
+    for option, row in zip(options, matrix):
+        groups.setdefault(tuple(row), []).append(option)
+    alike = [g for g in groups.values() if len(g) > 1]
+    if alike:
+        logging.getLogger(__name__).warning(
+            "%s: options with identical descriptors, which the models cannot tell apart: %s; choose more descriptors "
+            "(molecular_descriptors: all, a list) or give your own", where, "; ".join(", ".join(g) for g in alike))
 
 
 # names a descriptor cannot take: the functions of the constraint expressions

@@ -225,3 +225,13 @@ def test_options_from_an_sdf_file(tmp_path):
     ligand = load_config(cfg).space.parameters[0]
     assert ligand.smiles == {"methanol": "CO", "benzene": "c1ccccc1"}
     assert ligand.named_descriptors["aromatic_rings"] == {"methanol": 0.0, "benzene": 1.0}
+
+
+def test_molecules_the_descriptors_cannot_tell_apart_are_warned_about(caplog):
+    pytest.importorskip("rdkit")
+    isomers = {"o-xylene": "Cc1ccccc1C", "p-xylene": "Cc1ccc(C)cc1", "toluene": "Cc1ccccc1"}
+    cfg = {"parameters": [{"name": "solvent", "type": "categorical", "options": isomers}]}
+    with caplog.at_level("WARNING"):
+        load_config(cfg)
+    assert "identical descriptors" in caplog.text and "o-xylene, p-xylene" in caplog.text
+    assert "toluene" not in caplog.text
