@@ -235,3 +235,17 @@ def test_molecules_the_descriptors_cannot_tell_apart_are_warned_about(caplog):
         load_config(cfg)
     assert "identical descriptors" in caplog.text and "o-xylene, p-xylene" in caplog.text
     assert "toluene" not in caplog.text
+
+
+def test_computed_descriptors_are_learned_from_like_given_ones():
+    pytest.importorskip("rdkit")
+    cfg = {"parameters": [{"name": "ligand", "type": "categorical", "options": dict(LIGANDS)}],
+           "objectives": [{"name": "y", "goal": "max"}], "general": {"auto_desc_gen": True}}
+    planner = Planner(cfg, seed=0)
+    weight = load_config(cfg).space.parameters[0].named_descriptors["weight"]
+    for _ in range(4):
+        (proposal,) = planner.ask()
+        planner.tell({**proposal.params, "y": weight[proposal.params["ligand"]],
+                      "experiment_id": proposal.experiment_id})
+    relevance = planner.descriptor_summary()["ligand"]["objective"]["relevance"]
+    assert len(relevance) == len(DEFAULT_SET) and sum(relevance) == pytest.approx(1.0, abs=1e-3)
