@@ -240,6 +240,7 @@ def compute(name: str, smiles: Mapping[str, str], columns: tuple[str, ...], patt
     for option, text in smiles.items():
         if all((text, f) in cache for f in features):
             continue
+        rdkit(f"{where} (options given as SMILES)")
         mol = parse_smiles(text, f"{where}, option '{option}'")
         if any((text, p) not in cache for p in CATALOG):
             for key, value in properties_of(mol).items():

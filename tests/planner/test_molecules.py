@@ -106,7 +106,8 @@ def test_an_invalid_smarts_is_refused_naming_the_constraint_and_position():
 
 def test_a_smiles_config_without_rdkit_is_refused_naming_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "rdkit", None)  # `import rdkit` raises ImportError, as when it is not installed
-    with pytest.raises(ConfigError, match=r"needs RDKit.*pip install gryffin_ros\[molecules\]"):
+    with pytest.raises(ConfigError, match=r"parameter 'ligand' \(options given as SMILES\) needs RDKit, which is "
+                                          r"not installed: pip install gryffin_ros\[molecules\]"):
         load_config(config())
 
 
