@@ -1,6 +1,7 @@
 # The two commands of the README: `make demo` runs the main job, `make test` the test suite. Each first creates or
 # refreshes the local virtual environment with exactly the package set of requirements.lock (the set the suite
-# passed with), then the package itself with its test, ROS 2, interface-generator and colcon (workspace) extras, then
+# passed with), then the package itself with its test, ROS 2, interface-generator, colcon (workspace), recording and
+# molecules (RDKit) extras, then
 # builds the typed interfaces gryffin_ros_msgs into it (msg_schemas/build.sh).
 # `make lock` regenerates requirements.lock: a fresh environment resolved from the deliberate pins of
 # constraints.txt alone, frozen.
@@ -9,7 +10,7 @@ PYTHON ?= python3
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 LOCK := requirements.lock
-EXTRAS := .[test,ros,interfaces,workspace,record]
+EXTRAS := .[test,ros,interfaces,workspace,record,molecules]
 MSGS := $(VENV)/.interfaces
 
 # DDS stays on loopback in every process started from here (SPEC section 6), with the fast-discovery profile.

@@ -59,6 +59,8 @@ setup(
         "record": ["mcap>=1.1", "rosbags>=0.10"],
         # kept so that `pip install gryffin_ros[gp]` of earlier instructions still works; BoTorch is a dependency now
         "gp": [],
+        # SMILES options of categorical parameters: descriptors, structure constraints and drawings (RDKit)
+        "molecules": ["rdkit>=2023.9"],
     },
     entry_points={
         "console_scripts": [

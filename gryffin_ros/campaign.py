@@ -42,6 +42,7 @@ from .planner import Observation, Planner, Proposal
 from .planner.config import PlannerConfig, load_config, read_config
 from .planner.errors import GryffinRosError, ObservationError
 from .planner.history import History
+from .planner.molecules import MoleculeCache
 from .planner.reporting import Cancelled, ProgressCallback, reporting
 from .storage import CampaignStore
 
@@ -93,12 +94,15 @@ class Campaign:
         if base_dir is None and isinstance(config, (str, Path)):
             base_dir = Path(config).resolve().parent
         base = Path(base_dir) if base_dir is not None else None
-        checked = load_config(raw, base)  # validates; its hash identifies the campaign in the store
+        # RDKit's values for SMILES options are kept in the store: a restarted campaign does no RDKit work
+        self._molecules = MoleculeCache(CampaignStore.molecule_values_at(storage))
+        checked = load_config(raw, base, self._molecules)  # validates; its hash identifies the campaign in the store
         self.name = checked.name
         self.accept_unsolicited = accept_unsolicited
         self._raw, self._base = checked.raw, base
         self.store = CampaignStore(storage, checked.raw, checked.hash)
         try:
+            self.store.add_molecule_values(self._molecules.computed)
             stored_seed = self.store.get_meta("seed")
             if seed is None and stored_seed is not None:  # a campaign keeps its seed
                 seed = int(stored_seed)
@@ -133,7 +137,7 @@ class Campaign:
     def _tuned(self, settings: Mapping[str, Any]) -> PlannerConfig:
         tuned = copy.deepcopy(self._raw)
         tuned.setdefault("general", {}).update(settings)
-        return load_config(tuned, self._base)
+        return load_config(tuned, self._base, self._molecules)
 
     def use_settings(self, settings: Mapping[str, Any]) -> None:
         """Change settings (as `settings` at construction: how to optimize, not what) from the next proposal on;

@@ -25,6 +25,7 @@ from typing import Any
 from .planner.config import label, units_of
 from .planner.domain import Observation, Proposal
 from .planner.errors import GryffinRosError
+from .planner.molecules import smiles_of
 
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
@@ -37,6 +38,8 @@ CREATE TABLE IF NOT EXISTS claims (
     experiment_id TEXT PRIMARY KEY, instrument TEXT NOT NULL, claimed REAL NOT NULL);
 CREATE TABLE IF NOT EXISTS rejections (
     seq INTEGER PRIMARY KEY AUTOINCREMENT, experiment_id TEXT, reason TEXT NOT NULL, raw TEXT, received REAL NOT NULL);
+CREATE TABLE IF NOT EXISTS molecules (
+    smiles TEXT NOT NULL, feature TEXT NOT NULL, value REAL NOT NULL, PRIMARY KEY (smiles, feature));
 """
 # A refused message is kept up to this many characters (what was wrong is in the reason; the rest is evidence).
 REJECTED_RAW_CHARS = 4096
@@ -148,6 +151,21 @@ class CampaignStore:
         if set(rows) != {"config", "config_hash"}:
             raise StoreError(f"'{path}' is not a campaign store (no config recorded)")
         return cls(path, json.loads(rows["config"]), rows["config_hash"], readonly=True)
+
+    @classmethod
+    def molecule_values_at(cls, path: str | Path) -> dict[tuple[str, str], float]:
+        """The RDKit values kept by the store at `path` (see `molecule_values`); none when there is no store there
+        yet (read without the writer's lock: they never change once stored)."""
+        if str(path) == ":memory:" or not Path(path).is_file():
+            return {}
+        try:
+            store = cls.open_existing(path)
+        except StoreError:
+            return {}  # not a store: opening it as the writer says so
+        try:
+            return store.molecule_values()
+        finally:
+            store.close()
 
     @property
     def config(self) -> dict:
@@ -286,6 +304,21 @@ class CampaignStore:
     def count_observations(self) -> int:
         return self._query("SELECT COUNT(*) FROM observations")[0][0]
 
+    def molecule_values(self) -> dict[tuple[str, str], float]:
+        """What RDKit computed for the SMILES options of the config, by (SMILES, feature), so that a restarted
+        campaign needs no RDKit work (none in a store written before molecules were kept)."""
+        try:
+            rows = self._query("SELECT smiles, feature, value FROM molecules")
+        except sqlite3.OperationalError:
+            return {}
+        return {(smiles, feature): value for smiles, feature, value in rows}
+
+    def add_molecule_values(self, values: dict[tuple[str, str], float]) -> None:
+        if values:
+            with self._transaction():
+                self._db.executemany("INSERT OR REPLACE INTO molecules (smiles, feature, value) VALUES (?, ?, ?)",
+                                     [(smiles, feature, value) for (smiles, feature), value in values.items()])
+
     # ---- export ---------------------------------------------------------------------------------------------
     def rows(self, digits: int | None = None) -> list[dict[str, Any]]:
         """One flat row per observation: seq, experiment_id, parameters and objectives (headers with the config's
@@ -295,6 +328,7 @@ class CampaignStore:
         units = units_of(config)
         names = set(units)  # parameters and objectives: meta values of the same name are not repeated
         proposals = {p.experiment_id: p for p in self.proposals()}
+        smiles = smiles_of(config)
 
         def show(value: Any) -> Any:
             if digits is not None and isinstance(value, float):
@@ -304,7 +338,10 @@ class CampaignStore:
         out = []
         for seq, observation in enumerate(self.observations(), start=1):
             row: dict[str, Any] = {"seq": seq, "experiment_id": observation.experiment_id}
-            row.update({label(k, units): show(v) for k, v in observation.params.items()})
+            for k, v in observation.params.items():
+                row[label(k, units)] = show(v)
+                if k in smiles:  # a molecule's structure beside its name
+                    row[f"{k} SMILES"] = smiles[k].get(v, "")
             row.update({label(k, units): ("" if v is None else show(v)) for k, v in observation.objectives.items()})
             proposal = proposals.get(observation.experiment_id)
             row["failed"] = observation.failed

@@ -10,7 +10,7 @@ import pytest
 
 from gryffin_ros import messages
 from gryffin_ros.campaign import Campaign, CampaignClosed, Rejected
-from gryffin_ros.planner import ObservationError
+from gryffin_ros.planner import ConfigError, ObservationError
 from gryffin_ros.storage import StoreError
 
 CONFIG = {
@@ -436,3 +436,30 @@ def test_recent_rejections_are_read_from_the_store(tmp_path):
     assert campaign.recent_rejections(-60.0) == []  # a window ending a minute ago holds none of them
     campaign.close()
     assert campaign.recent_rejections(60.0) == []
+
+
+MOLECULES = {"name": "ligands",
+             "parameters": [{"name": "ligand", "type": "categorical",
+                             "options": {"PPh3": "c1ccc(P(c2ccccc2)c2ccccc2)cc1", "PMe3": "CP(C)C",
+                                         "pyridine": "c1ccncc1"}},
+                            {"name": "x", "type": "continuous", "low": 0.0, "high": 1.0}],
+             "objectives": [{"name": "y", "goal": "max"}],
+             "constraints": ["has_substructure(ligand, 'P') and weight(ligand) < 300"]}
+
+
+def test_a_restarted_campaign_takes_molecule_descriptors_from_its_store_without_rdkit(tmp_path, monkeypatch):
+    pytest.importorskip("rdkit")
+    path = tmp_path / "c.sqlite"
+    with Campaign(MOLECULES, path, seed=0) as campaign:
+        descriptors = campaign.config.space.parameters[0].descriptors
+        for proposal in campaign.propose(2):
+            campaign.observe(report(proposal))
+    monkeypatch.setitem(sys.modules, "rdkit", None)  # RDKit gone: the restart must not need it
+    with Campaign(MOLECULES, path) as restarted:
+        ligand = restarted.config.space.parameters[0]
+        assert (ligand.descriptors == descriptors).all() and ligand.substructures["P"]["pyridine"] is False
+        assert restarted.n_observations == 2
+        (proposal,) = restarted.propose(1)
+        assert proposal.params["ligand"] in ("PPh3", "PMe3")
+    with pytest.raises(ConfigError, match=r"pip install gryffin_ros\[molecules\]"):
+        Campaign(MOLECULES, tmp_path / "new.sqlite")  # a new store has nothing kept: RDKit is really unavailable

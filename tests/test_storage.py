@@ -113,3 +113,19 @@ def test_proposal_meta_is_stored_and_old_stores_gain_the_column(tmp_path):
     assert (old.experiment_id, old.meta, old.strategy) == ("old", {}, 1.0)
     assert new.meta == {"surrogate": "gp", "loo_rank_correlation": {"kde": 0.2, "gp": 0.9}}
     assert new.to_dict()["meta"]["surrogate"] == "gp" and "meta" not in old.to_dict()
+
+
+def test_csv_export_carries_the_smiles_of_molecules_and_the_store_keeps_rdkit_values(tmp_path):
+    config = {"name": "c", "parameters": [{"name": "solvent", "type": "categorical",
+                                           "options": {"toluene": "Cc1ccccc1", "DMF": "CN(C)C=O"}}]}
+    store = CampaignStore(tmp_path / "c.sqlite", config, "h1")
+    store.add_molecule_values({("Cc1ccccc1", "weight"): 92.14, ("CN(C)C=O", "smarts:N"): 1.0})
+    store.add_observation(Observation({"solvent": "DMF"}, {"y": 1.0}, "a"))
+    store.export_csv(tmp_path / "out.csv")
+    (row,) = csv.DictReader(open(tmp_path / "out.csv"))
+    assert (row["solvent"], row["solvent SMILES"]) == ("DMF", "CN(C)C=O")
+    assert list(row)[:4] == ["seq", "experiment_id", "solvent", "solvent SMILES"]
+    store.close()
+    assert CampaignStore.molecule_values_at(tmp_path / "c.sqlite") == {("Cc1ccccc1", "weight"): 92.14,
+                                                                        ("CN(C)C=O", "smarts:N"): 1.0}
+    assert CampaignStore.molecule_values_at(tmp_path / "none.sqlite") == {}

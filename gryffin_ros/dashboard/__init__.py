@@ -18,7 +18,7 @@ from typing import Any
 from urllib.parse import parse_qs, urlparse
 
 from ..planner.errors import GryffinRosError
-from .view import CampaignView
+from .view import CampaignView, CannotDraw
 
 LOOPBACK = {"127.0.0.1", "localhost", "::1"}
 
@@ -96,11 +96,17 @@ class _Handler(BaseHTTPRequestHandler):
             with self.server.lock:
                 if url.path == "/api/campaign":
                     return self._json(self.server.view.campaign())
+                if url.path == "/api/molecule.svg":
+                    query = parse_qs(url.query)
+                    svg = self.server.view.molecule_svg(query.get("parameter", [""])[0], query.get("option", [""])[0])
+                    return self._send(HTTPStatus.OK, svg.encode(), "image/svg+xml", cache=True)
                 if url.path == "/api/feasible":
                     query = parse_qs(url.query)
                     return self._json(self.server.view.feasible(query.get("x", [""])[0], query.get("y", [""])[0]))
         except ValueError as exc:
             return self._json({"error": str(exc)}, HTTPStatus.BAD_REQUEST)
+        except CannotDraw as exc:  # RDKit is not installed: the page shows the SMILES alone
+            return self._json({"error": str(exc)}, HTTPStatus.NOT_IMPLEMENTED)
         except Exception as exc:  # noqa: BLE001 - the page shows it; the server keeps serving
             return self._json({"error": f"{type(exc).__name__}: {exc}"}, HTTPStatus.INTERNAL_SERVER_ERROR)
         self._json({"error": f"no such page: {url.path}"}, HTTPStatus.NOT_FOUND)

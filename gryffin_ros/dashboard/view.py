@@ -13,7 +13,9 @@ import numpy as np
 from ..planner import Planner
 from ..planner.chimera import hierarchy, tolerance_line
 from ..planner.config import load_config, units_of
+from ..planner.errors import ConfigError, GryffinRosError
 from ..planner.merit import best_so_far
+from ..planner.molecules import MoleculeCache, draw_svg, smiles_of
 from ..storage import CampaignStore
 
 # The two-parameter view: a grid of GRID x GRID cells (continuous axes; one cell per option of a finite one), each
@@ -26,6 +28,10 @@ GRID = 40
 COMPLETIONS = 16
 SAMPLES = GRID * GRID * COMPLETIONS
 MAX_COMPLETIONS = 512
+
+
+class CannotDraw(GryffinRosError):
+    """A molecule cannot be drawn here (RDKit is not installed): the page shows its SMILES alone."""
 
 
 def _number(value: Any) -> Any:
@@ -41,11 +47,15 @@ class CampaignView:
         self.store = CampaignStore.open_existing(self.store_path)
         raw = self.store.config
         self.raw = raw
+        # RDKit's values for SMILES options, as the campaign stored them: the page needs RDKit only to draw molecules
+        molecules = MoleculeCache(self.store.molecule_values())
         # judging needs only the objectives: it always works, whatever the constraints refer to
-        self.config = load_config({**raw, "constraints": []})
+        self.config = load_config({**raw, "constraints": []}, molecule_cache=molecules)
+        self.smiles = smiles_of(raw)
+        self._drawings: dict[tuple[str, str], str] = {}
         base = Path(config_dir) if config_dir is not None else self.store_path.resolve().parent
         try:
-            self.planner: Planner | None = Planner(load_config(raw, base), seed=0)
+            self.planner: Planner | None = Planner(load_config(raw, base, molecules), seed=0)
             self.constraint_error: str | None = None
         except Exception as exc:  # noqa: BLE001 - shown on the page instead of the feasible region
             self.planner, self.constraint_error = None, f"{type(exc).__name__}: {exc}"
@@ -101,7 +111,8 @@ class CampaignView:
             "campaign": config.name, "version": list(version),
             "parameters": [{"name": p.name, "kind": p.kind, "units": units.get(p.name, ""),
                             "options": list(getattr(p, "options", ()) or ()) or None,
-                            "low": getattr(p, "low", None), "high": getattr(p, "high", None)}
+                            "low": getattr(p, "low", None), "high": getattr(p, "high", None),
+                            "smiles": self.smiles.get(p.name)}
                            for p in config.space.parameters],
             "objectives": [{"name": o.name, "goal": o.goal, "units": units.get(o.name, ""),
                             "tolerance": o.tolerance, "absolute": o.absolute} for o in config.objectives],
@@ -112,6 +123,20 @@ class CampaignView:
             "axes": list(modelled),
             "constraint_error": self.constraint_error,
         }
+
+    def molecule_svg(self, parameter: str, option: str) -> str:
+        """A drawing (SVG) of an option of a parameter given as SMILES; only the config's molecules are drawn.
+        Raises ValueError for anything else, CannotDraw without RDKit."""
+        smiles = self.smiles.get(parameter, {}).get(option)
+        if smiles is None:
+            raise ValueError(f"'{option}' is no molecule of '{parameter}'; molecules: "
+                             f"{ {name: sorted(options) for name, options in self.smiles.items()} }")
+        if (parameter, option) not in self._drawings:
+            try:
+                self._drawings[(parameter, option)] = draw_svg(smiles)
+            except ConfigError as exc:
+                raise CannotDraw(str(exc)) from None
+        return self._drawings[(parameter, option)]
 
     def feasible(self, x: str, y: str) -> dict[str, Any]:
         """The feasible share of each cell of the (x, y) plane, over the other parameters' domain (cached)."""

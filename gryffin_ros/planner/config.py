@@ -17,7 +17,10 @@ from typing import Any
 
 import yaml
 
+from . import molecules
+from .constraints.plugins import expression_text
 from .errors import ConfigError
+from .molecules import MoleculeCache, Molecules
 from .notices import note_no_effect
 from .space import SearchSpace
 
@@ -255,9 +258,35 @@ def _with_base_dir(constraints: list[Any], base_dir: Path | None) -> list[Any]:
     return out
 
 
-def load_config(source: Mapping | str | Path, base_dir: str | Path | None = None) -> PlannerConfig:
+def _molecules(raw: dict, base_dir: Path | None, cache: MoleculeCache) -> dict[str, Molecules]:
+    """What RDKit computes for the categorical parameters whose options are SMILES, by parameter name. Options read
+    from a CSV/SDF file are written into `raw` as option -> SMILES, so the config's hash and the stored config hold
+    the molecules themselves."""
+    specs = raw["parameters"] if isinstance(raw["parameters"], list) else []
+    found: dict[str, tuple[Mapping, dict[str, str]]] = {}
+    for i, spec in enumerate(specs):
+        if isinstance(spec, Mapping) and spec.get("type") == "categorical" and isinstance(spec.get("name"), str):
+            smiles = molecules.smiles_options(spec, base_dir)
+            if smiles is not None:
+                if isinstance(spec.get("options"), str):
+                    specs[i] = spec = {**spec, "options": smiles}
+                found[spec["name"]] = (spec, smiles)
+    if not found:
+        return {}
+    constraints = raw.get("constraints") if isinstance(raw.get("constraints"), list) else []
+    texts = [expression_text(c) or expression_text(c.get("options") if isinstance(c, Mapping)
+                                                    and c.get("plugin") == "expression" else None)
+             for c in constraints]
+    patterns = molecules.substructure_patterns([t for t in texts if t is not None], set(found))
+    return {name: molecules.compute(name, smiles, molecules.descriptor_columns(spec), patterns.get(name, {}), cache)
+            for name, (spec, smiles) in found.items()}
+
+
+def load_config(source: Mapping | str | Path, base_dir: str | Path | None = None,
+                molecule_cache: MoleculeCache | None = None) -> PlannerConfig:
     """Validate a config; relative file names in it are resolved against `base_dir`, by default the folder of the
-    config file (or the working directory for a dict)."""
+    config file (or the working directory for a dict). `molecule_cache` holds RDKit's values for SMILES options computed
+    earlier (a campaign's store keeps them); what is missing is computed and added to it."""
     raw = read_config(source)
     if base_dir is None and isinstance(source, (str, Path)):
         base_dir = Path(source).resolve().parent
@@ -266,7 +295,8 @@ def load_config(source: Mapping | str | Path, base_dir: str | Path | None = None
         raise ConfigError(f"unknown top-level config key(s) {sorted(unknown)}; allowed: {sorted(TOP_LEVEL_KEYS)}")
     if "parameters" not in raw:
         raise ConfigError("config has no 'parameters'")
-    space = SearchSpace.from_config(raw["parameters"])
+    base = Path(base_dir) if base_dir is not None else None
+    space = SearchSpace.from_config(raw["parameters"], _molecules(raw, base, molecule_cache or MoleculeCache()))
     objectives = _objectives(raw.get("objectives"), space.names)
     general = _general(raw.get("general"))
     _gryffin_section("database", raw.get("database"), GRYFFIN_DATABASE_KEYS, _NO_DATABASE)
@@ -277,5 +307,4 @@ def load_config(source: Mapping | str | Path, base_dir: str | Path | None = None
     name = raw.get("name", "campaign")
     if not isinstance(name, str) or not name.strip() or "/" in name or "\\" in name:
         raise ConfigError(f"'name' must be a non-empty string without path separators, got {name!r}")
-    base = Path(base_dir) if base_dir is not None else None
     return PlannerConfig(name, space, objectives, general, _with_base_dir(constraints, base), raw, base)

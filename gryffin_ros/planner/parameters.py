@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ConfigError
+from .molecules import SUBSTRUCTURE, Molecules
 from .notices import note_no_effect
 from .suggest import suggestion
 
@@ -51,6 +52,9 @@ class CategoricalParameter:
     # with `descriptor_names`: descriptor name -> option -> its value as given (unscaled), for constraints such as
     # `T < boiling_point(solvent) - 5`
     named_descriptors: Mapping[str, Mapping[str, float]] | None = field(default=None, compare=False)
+    # options given as SMILES: option -> SMILES, and SMARTS -> option -> match for `has_substructure(p, "SMARTS")`
+    smiles: Mapping[str, str] | None = field(default=None, compare=False)
+    substructures: Mapping[str, Mapping[str, bool]] | None = field(default=None, compare=False)
 
     kind = "categorical"
 
@@ -62,7 +66,8 @@ _COMMON_KEYS = {"name", "type", "size", "process_constrained", "units"}
 _ALLOWED_KEYS = {
     "continuous": _COMMON_KEYS | {"low", "high", "periodic", "size"},
     "discrete": _COMMON_KEYS | {"low", "high", "options", "size"},
-    "categorical": _COMMON_KEYS | {"options", "descriptors", "category_details", "descriptor_names", "size"},
+    "categorical": _COMMON_KEYS | {"options", "descriptors", "category_details", "descriptor_names", "size",
+                                   "molecular_descriptors"},
 }
 
 
@@ -75,7 +80,8 @@ def _number(spec: Mapping, key: str, where: str) -> float:
     return value
 
 
-def _rescale_descriptors(name: str, options: Sequence[str], table: Mapping) -> np.ndarray | None:
+def _descriptor_matrix(name: str, options: Sequence[str], table: Mapping) -> np.ndarray | None:
+    """The descriptors given per option as an (options, descriptors) matrix, as given; None when there are none."""
     unknown = [key for key in table if key not in options]
     if unknown:
         raise ConfigError(f"parameter '{name}': descriptors given for {unknown[0]!r}, which is not one of its options "
@@ -94,13 +100,19 @@ def _rescale_descriptors(name: str, options: Sequence[str], table: Mapping) -> n
         raise ConfigError(f"parameter '{name}': descriptors must be non-empty lists of numbers of equal length")
     if not np.all(np.isfinite(matrix)):
         raise ConfigError(f"parameter '{name}': descriptors must be finite numbers")
+    return matrix
+
+
+def _rescaled(matrix: np.ndarray) -> np.ndarray:
+    """Each column to [0, 1] (a constant column to 0)."""
     low, high = matrix.min(axis=0), matrix.max(axis=0)
     span = np.where(high > low, high - low, 1.0)
     return (matrix - low) / span
 
 
-def parameter_from_spec(spec: Mapping[str, Any], position: int) -> Parameter:
-    """Build one parameter from its config dict (Gryffin format accepted), with errors naming the key."""
+def parameter_from_spec(spec: Mapping[str, Any], position: int, molecules: Molecules | None = None) -> Parameter:
+    """Build one parameter from its config dict (Gryffin format accepted), with errors naming the key. A categorical
+    parameter whose options are SMILES needs `molecules`, what was computed for them (`molecules.compute`)."""
     if not isinstance(spec, Mapping):
         raise ConfigError(f"parameters[{position}] must be a mapping, got {type(spec).__name__}")
     name = spec.get("name")
@@ -157,6 +169,13 @@ def parameter_from_spec(spec: Mapping[str, Any], position: int) -> Parameter:
         return DiscreteParameter(name, tuple(range(int(low), int(high) + 1)), True)
 
     options = spec.get("options")
+    if isinstance(options, (Mapping, str)):
+        if molecules is None:
+            raise ConfigError(f"{where}: options given as SMILES are read by load_config (gryffin_ros.planner), "
+                              "which computes their descriptors")
+        options = list(molecules.smiles)
+    elif "molecular_descriptors" in spec:
+        raise ConfigError(f"{where}: 'molecular_descriptors' needs the options as SMILES (option: SMILES)")
     details = spec.get("category_details")
     for table in (details, spec.get("descriptors")):
         if options is None and isinstance(table, Mapping):
@@ -172,17 +191,42 @@ def parameter_from_spec(spec: Mapping[str, Any], position: int) -> Parameter:
     if "descriptors" in spec and details is not None:
         raise ConfigError(f"{where}: give either 'descriptors' or 'category_details', not both")
     table = spec.get("descriptors", details)
-    descriptors = None
+    given = None
     if table is not None:
         if not isinstance(table, Mapping):
             raise ConfigError(f"{where}: 'descriptors' must map each option to a list of numbers")
-        descriptors = _rescale_descriptors(name, options, table)
-    named = _named_descriptors(where, spec.get("descriptor_names"), options, table, descriptors)
-    return CategoricalParameter(name, tuple(options), descriptors, named)
+        given = _descriptor_matrix(name, options, table)
+    named = _named_descriptors(where, spec.get("descriptor_names"), options, table, given)
+    if molecules is None:
+        return CategoricalParameter(name, tuple(options), None if given is None else _rescaled(given), named)
+    clash = sorted(set(named or {}) & set(molecules.properties))
+    if clash:
+        raise ConfigError(f"{where}: descriptor name(s) {clash} are computed from the SMILES; give your own values "
+                          "other names")
+    computed = np.array([[molecules.properties[c][o] for c in molecules.columns] for o in options]).reshape(
+        len(options), len(molecules.columns))
+    matrix = computed if given is None else np.hstack([given, computed])
+    if matrix.shape[1]:
+        _warn_alike(where, options, matrix)
+    return CategoricalParameter(name, tuple(options), _rescaled(matrix) if matrix.shape[1] else None,
+                                {**(named or {}), **molecules.properties}, dict(molecules.smiles),
+                                molecules.substructures)
+
+
+def _warn_alike(where: str, options: Sequence[str], matrix: np.ndarray) -> None:
+    """Warn about molecules whose descriptors are all equal (isomers, often): the models cannot tell them apart."""
+    groups: dict[tuple, list[str]] = {}
+    for option, row in zip(options, matrix):
+        groups.setdefault(tuple(row), []).append(option)
+    alike = [g for g in groups.values() if len(g) > 1]
+    if alike:
+        logging.getLogger(__name__).warning(
+            "%s: options with identical descriptors, which the models cannot tell apart: %s; choose more descriptors "
+            "(molecular_descriptors: all, a list) or give your own", where, "; ".join(", ".join(g) for g in alike))
 
 
 # names a descriptor cannot take: the functions of the constraint expressions
-RESERVED_NAMES = {"abs", "sqrt", "exp", "log", "min", "max"}
+RESERVED_NAMES = {"abs", "sqrt", "exp", "log", "min", "max", SUBSTRUCTURE}
 
 
 def _named_descriptors(where: str, names: Any, options: Sequence[str], table: Mapping | None,

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ConfigError, ObservationError
+from .molecules import Molecules
 from .parameters import (
     CategoricalParameter,
     ContinuousParameter,
@@ -47,10 +48,13 @@ class SearchSpace:
         self._index = {p.name: {o: i for i, o in enumerate(p.options)} for p in parameters if p.kind != "continuous"}
 
     @classmethod
-    def from_config(cls, specs: Any) -> SearchSpace:
+    def from_config(cls, specs: Any, molecules: Mapping[str, Molecules] | None = None) -> SearchSpace:
+        """`molecules`: what was computed for the parameters whose options are SMILES, by name (`load_config`)."""
         if not isinstance(specs, (list, tuple)):
             raise ConfigError("'parameters' must be a list of parameter definitions")
-        return cls([parameter_from_spec(spec, i) for i, spec in enumerate(specs)])
+        molecules = molecules or {}
+        return cls([parameter_from_spec(spec, i, molecules.get(spec.get("name")) if isinstance(spec, Mapping) else None)
+                    for i, spec in enumerate(specs)])
 
     # ---- sizes ---------------------------------------------------------------------------------------------
     @property

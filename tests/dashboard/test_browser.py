@@ -6,6 +6,7 @@ import time
 
 import pytest
 
+from gryffin_ros.campaign import Campaign
 from gryffin_ros.dashboard import start
 
 from .conftest import add_one
@@ -73,5 +74,34 @@ def test_the_page_shows_the_store_and_follows_it_live(campaign, browser, tmp_pat
         wait_for(lambda: browser.execute_script(
             "return document.querySelector('#experiments tbody tr td').textContent") == "6")
         browser.save_screenshot(str(tmp_path / "dashboard.png"))
+    finally:
+        server.close()
+
+
+def test_the_page_shows_the_smiles_and_draws_the_pending_molecules(browser, tmp_path):
+    pytest.importorskip("rdkit")
+    config = {"name": "m", "parameters": [{"name": "solvent", "type": "categorical",
+                                           "options": {"toluene": "Cc1ccccc1", "DMF": "CN(C)C=O"}},
+                                          {"name": "T", "type": "continuous", "low": 20.0, "high": 100.0}],
+              "objectives": [{"name": "y", "goal": "max"}]}
+    with Campaign(config, tmp_path / "m.sqlite", seed=0) as campaign:
+        (proposal,) = campaign.propose(1)
+        campaign.observe({"experiment_id": proposal.experiment_id, "params": proposal.params, "objectives": {"y": 1}})
+        (pending,) = campaign.propose(1)
+    server = start(tmp_path / "m.sqlite", port=0)
+    try:
+        browser.get(server.url)
+        wait_for(lambda: rows(browser) == 1)
+        headers = [th.text for th in browser.find_elements("css selector", "#experiments th")]
+        assert headers[headers.index("solvent") + 1] == "solvent SMILES"
+        shown = browser.find_element("css selector", "#experiments tbody tr").text
+        assert config["parameters"][0]["options"][proposal.params["solvent"]] in shown
+        # the pending proposal's molecule, drawn by the server: an image that loaded
+        wait_for(lambda: browser.execute_script(
+            "const i = document.querySelector('#pending td.molecule img'); return !!i && i.complete && "
+            "i.naturalWidth > 0"))
+        alt = browser.execute_script("return document.querySelector('#pending td.molecule img').alt")
+        assert alt == pending.params["solvent"]
+        assert [e for e in browser.get_log("browser") if e["level"] == "SEVERE"] == []
     finally:
         server.close()

@@ -1,11 +1,13 @@
 """The dashboard's server over real HTTP on loopback: pages, the offline plotting library, read-only."""
 
 import json
+import sys
 import urllib.error
 import urllib.request
 
 import pytest
 
+from gryffin_ros.campaign import Campaign
 from gryffin_ros.dashboard import start
 
 
@@ -66,3 +68,39 @@ def test_a_port_that_cannot_be_served_is_a_clear_error(campaign, server):
         start(campaign.store.path, port=server.server_port)  # taken
     with pytest.raises(GryffinRosError, match="port must be 0..65535"):
         start(campaign.store.path, port=70000)
+
+
+MOLECULES = {"name": "solvents",
+             "parameters": [{"name": "solvent", "type": "categorical",
+                             "options": {"toluene": "Cc1ccccc1", "DMF": "CN(C)C=O", "<b>": "CO"}},
+                            {"name": "T", "type": "continuous", "low": 20.0, "high": 100.0}],
+             "objectives": [{"name": "y", "goal": "max"}]}
+
+
+@pytest.fixture
+def molecule_server(tmp_path):
+    pytest.importorskip("rdkit")
+    with Campaign(MOLECULES, tmp_path / "m.sqlite", seed=0) as campaign:
+        (proposal,) = campaign.propose(1)
+        campaign.observe({"experiment_id": proposal.experiment_id, "params": proposal.params,
+                          "objectives": {"y": 1.0}})
+        campaign.propose(1)
+    server = start(tmp_path / "m.sqlite", port=0)
+    yield server
+    server.close()
+
+
+def test_the_molecules_of_the_config_are_drawn_and_nothing_else(molecule_server, monkeypatch):
+    url = molecule_server.url
+    data = json.loads(get(url + "api/campaign")[2])
+    assert data["parameters"][0]["smiles"] == MOLECULES["parameters"][0]["options"]
+    status, kind, svg = get(url + "api/molecule.svg?parameter=solvent&option=DMF")
+    assert status == 200 and kind == "image/svg+xml" and svg.lstrip().startswith(b"<?xml") and b"<svg" in svg
+    assert get(url + "api/molecule.svg?parameter=solvent&option=%3Cb%3E")[0] == 200  # a name that needs quoting
+    with pytest.raises(urllib.error.HTTPError) as other:  # only the config's molecules: no SMILES from the URL
+        get(url + "api/molecule.svg?parameter=solvent&option=CCO")
+    assert other.value.code == 400 and "no molecule of 'solvent'" in json.loads(other.value.read())["error"]
+    monkeypatch.setitem(sys.modules, "rdkit", None)  # without RDKit the page keeps the SMILES and draws nothing
+    with pytest.raises(urllib.error.HTTPError) as missing:
+        get(url + "api/molecule.svg?parameter=solvent&option=toluene")
+    assert missing.value.code == 501 and "gryffin_ros[molecules]" in json.loads(missing.value.read())["error"]

@@ -1,9 +1,12 @@
 """The dashboard's data, from a real store: what the page shows, without a browser."""
 
 import json
+import sys
 
 import numpy as np
+import pytest
 
+from gryffin_ros.campaign import Campaign
 from gryffin_ros.dashboard.view import GRID, CampaignView
 from gryffin_ros.planner.config import load_config
 from gryffin_ros.planner.merit import best_so_far
@@ -81,4 +84,19 @@ def test_shares_by_category_are_the_same_where_the_constraint_ignores_the_catego
     completions = 16 * GRID * GRID // share.size
     # a share of n independent draws: 4 standard errors of the worst case p = 0.5 (a cell off by chance: 6e-5)
     assert np.abs(share[0] - truth).max() < 4 * np.sqrt(0.25 / completions)
+    view.close()
+
+
+def test_the_view_of_a_molecule_campaign_needs_no_rdkit_for_what_was_stored(tmp_path, monkeypatch):
+    pytest.importorskip("rdkit")
+    config = {"name": "m", "parameters": [{"name": "solvent", "type": "categorical",
+                                           "options": {"toluene": "Cc1ccccc1", "DMF": "CN(C)C=O"}}],
+              "constraints": ["weight(solvent) < 80"]}
+    with Campaign(config, tmp_path / "m.sqlite", seed=0) as campaign:
+        campaign.propose(1)
+    monkeypatch.setitem(sys.modules, "rdkit", None)
+    view = CampaignView(tmp_path / "m.sqlite")
+    assert view.constraint_error is None  # the constraint was loaded from the stored values
+    assert view.campaign()["parameters"][0]["smiles"] == {"toluene": "Cc1ccccc1", "DMF": "CN(C)C=O"}
+    assert view.campaign()["pending"][0]["params"] == {"solvent": "DMF"}
     view.close()

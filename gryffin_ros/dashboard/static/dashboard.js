@@ -173,11 +173,18 @@ function escape(text) {
   return String(text).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
 }
 
+function drawing(parameter, option) {
+  // the server draws the config's molecules (RDKit); without RDKit the image is hidden and the SMILES column stays
+  const src = `api/molecule.svg?parameter=${encodeURIComponent(parameter)}&option=${encodeURIComponent(option)}`;
+  return `<img src="${escape(src)}" alt="${escape(option)}" onerror="this.remove()">`;
+}
+
 function table(element, columns, rows, sortable) {
   const head = columns.map((c) => `<th class="${c.text ? "text" : ""}" data-key="${escape(c.key)}">${escape(c.title)}` +
     `${sortable && state.sortKey === c.key ? (state.sortUp ? " ▲" : " ▼") : ""}</th>`).join("");
-  const body = rows.map((r) => `<tr class="${r.failed ? "failed" : ""}">` + columns.map((c) =>
-    `<td class="${c.text ? "text" : ""}">${escape(fmt(c.get(r)))}</td>`).join("") + "</tr>").join("");
+  const body = rows.map((r) => `<tr class="${r.failed ? "failed" : ""}">` + columns.map((c) => c.drawing
+    ? `<td class="molecule">${drawing(c.drawing, c.get(r))}</td>`
+    : `<td class="${c.text ? "text" : ""}">${escape(fmt(c.get(r)))}</td>`).join("") + "</tr>").join("");
   element.innerHTML = `<thead><tr>${head}</tr></thead><tbody>${body}</tbody>`;
   if (sortable) {
     for (const th of element.querySelectorAll("th")) {
@@ -193,8 +200,9 @@ function table(element, columns, rows, sortable) {
 function drawTables(d) {
   const columns = [{ key: "seq", title: "#", get: (e) => e.seq },
     { key: "experiment_id", title: "experiment", text: true, get: (e) => e.experiment_id.slice(0, 8) },
-    ...d.parameters.map((p) => ({ key: `p:${p.name}`, title: label(p), text: p.kind === "categorical",
-      get: (e) => e.params[p.name] })),
+    ...d.parameters.flatMap((p) => [{ key: `p:${p.name}`, title: label(p), text: p.kind === "categorical",
+      get: (e) => e.params[p.name] }, ...(p.smiles ? [{ key: `s:${p.name}`, title: `${p.name} SMILES`, text: true,
+      get: (e) => p.smiles[e.params[p.name]] }] : [])]),
     ...d.objectives.map((o) => ({ key: `o:${o.name}`, title: label(o), get: (e) => e.objectives[o.name] })),
     { key: "failed", title: "failed", text: true, get: (e) => (e.failed ? "yes" : "") },
     { key: "strategy", title: "strategy", get: (e) => e.strategy },
@@ -206,8 +214,10 @@ function drawTables(d) {
     return state.sortUp ? order : -order;
   });
   table($("experiments"), columns, rows, true);
+  const drawings = d.parameters.filter((p) => p.smiles).map((p) => ({ key: `m:${p.name}`, title: p.name,
+    drawing: p.name, get: (e) => e.params[p.name] }));
   table($("pending"), columns.filter((c) => c.key === "experiment_id" || c.key.startsWith("p:") ||
-    c.key === "strategy" || c.key === "surrogate"), d.pending, false);
+    c.key.startsWith("s:") || c.key === "strategy" || c.key === "surrogate").concat(drawings), d.pending, false);
   table($("rejected"), [{ key: "id", title: "experiment", text: true, get: (r) => (r.experiment_id || "").slice(0, 8) },
     { key: "reason", title: "reason", text: true, get: (r) => r.reason }], d.rejected, false);
   $("n-pending").textContent = `(${d.pending.length})`;

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError
+from ..molecules import CATALOG, SUBSTRUCTURE
 from ..suggest import suggestion
 from .literals import check_literals, literal_values
 
@@ -159,10 +160,13 @@ class Expression:
     def _compile_call(self, node: ast.Call) -> Node:
         if node.keywords:
             raise self._reject(node, "keyword arguments")
+        if isinstance(node.func, ast.Name) and node.func.id == SUBSTRUCTURE:
+            return self._compile_substructure(node)
         if isinstance(node.func, ast.Name) and node.func.id not in _FUNCTIONS:
             return self._compile_descriptor(node)
         if not isinstance(node.func, ast.Name):
-            raise self._reject(node, "calling anything but abs, min, max, sqrt, exp, log or a named descriptor")
+            raise self._reject(node, "calling anything but abs, min, max, sqrt, exp, log, has_substructure or a named "
+                                     "descriptor")
         fn, low, high = _FUNCTIONS[node.func.id]
         if len(node.args) < low or (high is not None and len(node.args) > high):
             raise self._reject(node, f"{node.func.id}() with {len(node.args)} argument(s)")
@@ -180,27 +184,56 @@ class Expression:
                 or node.args[0].id not in categorical):
             if function in offered:
                 raise self._reject(node, f"{function}() of anything but one categorical parameter's name")
-            raise self._reject(node, f"calling '{function}'; functions are abs, min, max, sqrt, exp, log and the "
-                                     f"named descriptors of categorical parameters {offered}"
+            raise self._reject(node, f"calling '{function}'; functions are abs, min, max, sqrt, exp, log, "
+                                     f"{SUBSTRUCTURE} and the named descriptors of categorical parameters {offered}"
                                      f"{suggestion(function, offered)}")
         parameter = categorical[node.args[0].id]
         table = (parameter.named_descriptors or {}).get(function)
         if table is None:
             names = sorted(parameter.named_descriptors or {})
+            hint = ("; its descriptors are " + f"{names}{suggestion(function, names)}" if names
+                    else " (give it 'descriptors' and 'descriptor_names')")
+            if function in CATALOG and parameter.smiles is None:
+                hint = f" ({function}() is computed for options given as SMILES: {{option: SMILES}})"
             raise ConfigError(f"constraint {self.text!r}: parameter '{parameter.name}' has no descriptor named "
-                              f"'{function}'" + (f"; its descriptors are {names}{suggestion(function, names)}" if names
-                                                 else " (give it 'descriptors' and 'descriptor_names')"))
+                              f"'{function}'{hint}")
         self.variables.add(parameter.name)
-        options = list(table)
-        values = np.array([table[o] for o in options], dtype=float)
+        return _per_option(parameter.name, table, float, np.nan)
 
-        def lookup(cols: Columns) -> np.ndarray:
-            column = np.asarray(cols[parameter.name], dtype=object)
-            out = np.full(column.shape, np.nan)
-            for option, value in zip(options, values):
-                out[column == option] = value
-            return out
-        return lookup
+    def _compile_substructure(self, node: ast.Call) -> Node:
+        """`has_substructure(parameter, "SMARTS")`: whether the molecule of each row's option contains the pattern;
+        matched once per option when the config was loaded."""
+        molecular = sorted(n for n, p in self._parameters.items() if getattr(p, "smiles", None) is not None)
+        args = node.args
+        if len(args) != 2 or not isinstance(args[0], ast.Name) or not (isinstance(args[1], ast.Constant)
+                                                                        and isinstance(args[1].value, str)):
+            raise self._reject(node, f"{SUBSTRUCTURE}() with anything but a parameter whose options are SMILES "
+                                     f"({', '.join(molecular) or 'none here'}) and a SMARTS string")
+        name, smarts = args[0].id, args[1].value
+        parameter = self._parameters.get(name)
+        if parameter is None or getattr(parameter, "smiles", None) is None:
+            raise self._reject(node, f"{SUBSTRUCTURE}() of '{name}', whose options are not given as SMILES (those "
+                                     f"that are: {molecular or 'none'})")
+        table = (parameter.substructures or {}).get(smarts)
+        if table is None:  # matched only for the constraints of the config being loaded
+            raise ConfigError(f"constraint {self.text!r}: {SUBSTRUCTURE}({name}, {smarts!r}) was not matched when "
+                              "the config was loaded; give this constraint in the config's 'constraints'")
+        self.variables.add(name)
+        return _per_option(name, table, bool, False)
+
+
+def _per_option(name: str, table: Mapping[str, Any], dtype: type, missing: Any) -> Node:
+    """A column of per-option values (`table`: option -> value) looked up from the options in column `name`."""
+    options = list(table)
+    values = [table[o] for o in options]
+
+    def lookup(cols: Columns) -> np.ndarray:
+        column = np.asarray(cols[name], dtype=object)
+        out = np.full(column.shape, missing, dtype=dtype)
+        for option, value in zip(options, values):
+            out[column == option] = value
+        return out
+    return lookup
 
 
 # ---- linear forms (equalities solved exactly; linear inequalities as half-spaces) ------------------------
