@@ -4,7 +4,7 @@
 (`install/gryffin_ros/lib/gryffin_ros/planner_node`, what `ros2 run gryffin_ros planner_node` starts) with the installed
 params file and example, and serves a typed Recommend goal to a client that imports the installed packages.
 
-The workspace is built once for the module (a plain build, as a lab does; about 1-2 minutes on 2 cores)."""
+The workspace is built once (a plain build, as a lab does; about 2 minutes on 2 cores)."""
 
 from __future__ import annotations
 
@@ -77,8 +77,7 @@ def workspace(tmp_path_factory):
     return root, sourced
 
 
-def test_both_packages_build_and_install_the_ros_layout(workspace):
-    root, env = workspace
+def check_the_ros_layout(root: Path, env: dict[str, str]) -> None:
     install = root / "install"
     for package in ("gryffin_ros", "gryffin_ros_msgs"):
         assert (install / package / "share/ament_index/resource_index/packages" / package).is_file()
@@ -101,8 +100,11 @@ def test_both_packages_build_and_install_the_ros_layout(workspace):
     assert imported[2] == str(share / "examples")
 
 
-def test_the_installed_planner_node_serves_a_typed_recommend_goal(workspace, tmp_path):
+def test_the_workspace_builds_both_packages_and_the_installed_planner_node_serves_a_recommend_goal(workspace,
+                                                                                                     tmp_path):
+    """One test, so that pytest-xdist never splits it over two workers (each would build the workspace)."""
     root, env = workspace
+    check_the_ros_layout(root, env)
     share = root / "install/gryffin_ros/share/gryffin_ros"
     node = root / "install/gryffin_ros/lib/gryffin_ros/planner_node"
     storage = tmp_path / "flow.sqlite"
