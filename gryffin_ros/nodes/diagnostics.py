@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 from typing import Any
 
-from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
 from ..campaign import Campaign
 
@@ -47,3 +47,18 @@ def planner_status(lifecycle_state: str, campaign: Campaign | None, storage: str
         values["last_error"] = last_error
     return DiagnosticStatus(level=level, name=name, message=message, hardware_id=hardware_id,
                             values=[KeyValue(key=k, value=str(v)) for k, v in values.items()])
+
+
+def publish(node: Any) -> None:
+    """The planner node's status on /diagnostics (every lifecycle state; nothing once it is closing)."""
+    if node._closing:
+        return
+    array = DiagnosticArray()
+    array.header.stamp = node.get_clock().now().to_msg()
+    array.status = [planner_status(node.lifecycle_state(), node.campaign, node.storage, node.configure_error,
+                                   node.get_fully_qualified_name())]
+    try:
+        node.diagnostics_pub.publish(array)
+    except Exception:  # noqa: BLE001 - the context is going away
+        if not node._closing:
+            raise

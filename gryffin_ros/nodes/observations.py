@@ -17,19 +17,25 @@ from ..campaign import Campaign
 from ..planner import GryffinRosError
 from . import typed
 from .outputs import Outputs
+from .qos import OBSERVATIONS_SUBSCRIPTION_QOS
+from .recorder import BagRecorder
 
 
 class ObservationInput:
     def __init__(self, campaign: Campaign, outputs: Outputs, accepted: Callable[[], None],
-                 max_message_bytes: Callable[[], int], logger: Any,
-                 record: Callable[[str, Any], None] | None = None):
+                 max_message_bytes: Callable[[], int], logger: Any, recorder: BagRecorder | None = None,
+                 resolve: Callable[[str], str] = str):
         self._campaign, self._outputs, self._accepted = campaign, outputs, accepted
         self._max_bytes, self._logger = max_message_bytes, logger
-        self._record = record  # (which input: "typed" or "json", the message)
+        self._recorder = recorder  # each message as received, under its topic's name on the wire (`resolve`)
+        self._topics = {"typed": resolve("~/observations"), "json": resolve("~/json/observations")}
+
+    def _record(self, kind: str, msg: Any) -> None:
+        if self._recorder is not None:
+            self._recorder.record(self._topics[kind], msg, OBSERVATIONS_SUBSCRIPTION_QOS)
 
     def on_typed(self, msg: typed.Observation) -> None:
-        if self._record is not None:
-            self._record("typed", msg)
+        self._record("typed", msg)
         raw = typed.observation_record(msg)
         try:
             item = typed.observation_item(msg)
@@ -39,8 +45,7 @@ class ObservationInput:
         self._take([item], lambda _item: raw)
 
     def on_json(self, msg: String) -> None:
-        if self._record is not None:
-            self._record("json", msg)
+        self._record("json", msg)
         try:
             items = messages.observation_items(messages.parse("observation", msg.data, self._max_bytes()))
         except GryffinRosError as exc:  # the id, when the refused message names one (schema errors)

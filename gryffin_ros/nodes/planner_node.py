@@ -11,7 +11,6 @@ reports the node in every state.
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
@@ -31,15 +30,12 @@ from .outputs import Outputs
 from .parameters import PARAMETERS, READ_ONLY, check_parameter, settings
 from .qos import DIAGNOSTICS_QOS, OBSERVATIONS_SUBSCRIPTION_QOS, SERVICES_QOS
 from .recommend import Asks
-from .recorder import CONFIG_DIR_KEY, CONFIG_KEY, SEED_KEY, BagRecorder
+from .recorder import BagRecorder, campaign_recorder
 from .runner import declare, run
 from .typed import GetStatus, Recommend
 from .web import start_dashboard
 
 DIAGNOSTICS_PERIOD_S = 1.0
-# what the node records with `record`: its typed outputs and both kinds of observation input
-RECORDED_TYPES = ("gryffin_ros_msgs/msg/Proposals", "gryffin_ros_msgs/msg/Event",
-                  "gryffin_ros_msgs/msg/CampaignStatus", "gryffin_ros_msgs/msg/Observation", "std_msgs/msg/String")
 DEACTIVATED = "the planner was deactivated while recommending; nothing was proposed"
 SHUTTING_DOWN = "the planner is shutting down; nothing was proposed (ask again when it is back)"
 
@@ -68,7 +64,8 @@ class PlannerNode(LifecycleNode):
         self.add_on_set_parameters_callback(self._on_set_parameters)
         # always there, in every state: a lifecycle manager and an operator see why a node is not running
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", DIAGNOSTICS_QOS)
-        self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics, callback_group=ReentrantCallbackGroup())
+        self.create_timer(DIAGNOSTICS_PERIOD_S, lambda: diagnostics.publish(self),
+                          callback_group=ReentrantCallbackGroup())
 
     # ---- lifecycle -------------------------------------------------------------------------------------------
     def lifecycle_state(self) -> str:
@@ -91,10 +88,9 @@ class PlannerNode(LifecycleNode):
                 self.dashboard = start_dashboard(storage, p["dashboard_host"], p["dashboard_port"], p["config"],
                                                  self.get_logger())
             # every typed message sent or received, into a bag (docs/ros.md, "Recording a campaign")
-            if p["record"]:  # with what `gryffin-ros import` needs to make a store of the bag again
-                self.recorder = BagRecorder(p["record"], custom_data={
-                    CONFIG_KEY: campaign.store.get_meta("config") or "", SEED_KEY: str(campaign.seed),
-                    CONFIG_DIR_KEY: str(Path(p["config"]).resolve().parent)}, types=RECORDED_TYPES)
+            if p["record"]:
+                self.recorder = campaign_recorder(p["record"], p["config"], campaign.store.get_meta("config") or "",
+                                                  campaign.seed)
         except BaseException:
             if self.dashboard is not None:
                 self.dashboard.close()
@@ -109,7 +105,7 @@ class PlannerNode(LifecycleNode):
         self.outputs = Outputs(self, campaign, lambda: self._active and not self._closing, lambda: self._closing,
                                self.recorder)
         self.observations = ObservationInput(campaign, self.outputs, self._wake, lambda: self.p["max_message_bytes"],
-                                             self.get_logger(), self._record_input if self.recorder else None)
+                                             self.get_logger(), self.recorder, self.resolve_topic_name)
         self.asks = Asks(campaign, self.outputs, lambda: self.p["batch_size"])
         self._action = ActionServer(self, Recommend, "~/recommend", execute_callback=self.asks.execute_recommend,
                                     goal_callback=self._on_goal, cancel_callback=lambda _goal: CancelResponse.ACCEPT,
@@ -119,10 +115,6 @@ class PlannerNode(LifecycleNode):
             f"{len(campaign.pending)} pending; feasible fraction {fraction.value:.3g} ({fraction.method}); seed "
             f"{campaign.seed}; acquisition optimizer {campaign.config.general.acquisition_optimizer}")
 
-    def _record_input(self, kind: str, msg) -> None:
-        topic = self.resolve_topic_name("~/observations" if kind == "typed" else "~/json/observations")
-        self.recorder.record(topic, msg, OBSERVATIONS_SUBSCRIPTION_QOS)
-
     def on_configure(self, state) -> TransitionCallbackReturn:
         try:
             self._open_campaign()
@@ -130,7 +122,7 @@ class PlannerNode(LifecycleNode):
             reason = str(exc) if isinstance(exc, GryffinRosError) else f"internal error: {exc!r}"
             self.configure_error = reason
             self.get_logger().error(f"configure failed: {reason}")
-            self._publish_diagnostics()
+            diagnostics.publish(self)
             return TransitionCallbackReturn.FAILURE
         self.configure_error = None
         return TransitionCallbackReturn.SUCCESS
@@ -259,20 +251,6 @@ class PlannerNode(LifecycleNode):
         if campaign is not None and ("auto_propose" in changes or "batch_size" in changes):
             self._wake()
         return SetParametersResult(successful=True)
-
-    # ---- outputs ---------------------------------------------------------------------------------------------
-    def _publish_diagnostics(self) -> None:
-        if self._closing:
-            return
-        array = DiagnosticArray()
-        array.header.stamp = self.get_clock().now().to_msg()
-        array.status = [diagnostics.planner_status(self.lifecycle_state(), self.campaign, self.storage,
-                                                   self.configure_error, self.get_fully_qualified_name())]
-        try:
-            self.diagnostics_pub.publish(array)
-        except Exception:  # noqa: BLE001 - the context is going away
-            if not self._closing:
-                raise
 
     # ---- inputs ----------------------------------------------------------------------------------------------
     def _wake(self) -> None:

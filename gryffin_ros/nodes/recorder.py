@@ -142,6 +142,18 @@ class _Segment:
     end_ns: int = 0
 
 
+# what the planner node records with `record`: its typed outputs and both kinds of observation input
+PLANNER_TYPES = ("gryffin_ros_msgs/msg/Proposals", "gryffin_ros_msgs/msg/Event", "gryffin_ros_msgs/msg/CampaignStatus",
+                 "gryffin_ros_msgs/msg/Observation", "std_msgs/msg/String")
+
+
+def campaign_recorder(path: str, config: str, store_config: str, seed: int) -> BagRecorder:
+    """The planner node's recorder: its message types, and in metadata.yaml what `gryffin-ros import` needs to make
+    a store of the bag again (the stored config, the seed, the config's folder for its relative file names)."""
+    return BagRecorder(path, custom_data={CONFIG_KEY: store_config, SEED_KEY: str(seed),
+                                          CONFIG_DIR_KEY: str(Path(config).resolve().parent)}, types=PLANNER_TYPES)
+
+
 class BagRecorder:
     """Records messages into the bag folder `path` (which must not exist yet); `close` finishes it."""
 
