@@ -253,6 +253,52 @@ class Discrete(Task):
         return dense_reference(self, cont_steps=61)
 
 
+COUPLING_LIGANDS = {"PPh3": (145.0, 0.6), "SPhos": (230.0, 0.85), "XPhos": (256.0, 0.9), "dppf": (170.0, 0.5),
+                    "PCy3": (170.0, 1.0)}  # cone angle (deg), donor strength (normalized)
+COUPLING_BASES = {"K2CO3": (10.3, 0.2), "K3PO4": (12.3, 0.3), "Cs2CO3": (10.3, 0.9),
+                  "Et3N": (10.7, 1.0)}  # pKa of the conjugate acid, solubility in organic solvents (normalized)
+COUPLING_SOLVENTS = {"toluene": (111.0, 0.10), "dioxane": (101.0, 0.16), "THF": (66.0, 0.21), "DMF": (153.0, 0.39),
+                     "EtOH": (78.0, 0.65)}  # boiling point (deg C), polarity (E_T(30), normalized)
+COUPLING_FORBIDDEN = {("K3PO4", "THF"), ("Cs2CO3", "toluene"), ("Et3N", "EtOH")}  # base, solvent: not compatible
+
+
+class Coupling(Task):
+    """A Suzuki-like coupling: ligand, base and solvent (categorical, with descriptors) + temperature, time and
+    catalyst loading (continuous). Known constraints: temperature 5 deg C below the solvent's boiling point, a cap on
+    loading x temperature (heat release), base/solvent pairs that do not work. The best ligand depends on the
+    solvent's polarity, the base's strength speeds the coupling and the side reaction (protodeboronation, hot and
+    strong bases), a base must dissolve: several decent combinations and one best, far apart in descriptor space."""
+    name, family, budget = "m_coupling", "mixed", 40
+
+    def __init__(self):
+        self.ligands, self.bases, self.solvents = list(COUPLING_LIGANDS), list(COUPLING_BASES), list(COUPLING_SOLVENTS)
+        self.params = [CatParam("ligand", self.ligands, COUPLING_LIGANDS), CatParam("base", self.bases, COUPLING_BASES),
+                       CatParam("solvent", self.solvents, COUPLING_SOLVENTS), Param("T", "float", 25.0, 150.0),
+                       Param("t", "float", 0.5, 24.0), Param("loading", "float", 0.5, 5.0)]
+
+    def feasible(self, x):
+        base, solvent, T, loading = self.bases[int(x[1])], self.solvents[int(x[2])], x[3], x[5]
+        return (T <= COUPLING_SOLVENTS[solvent][0] - 5.0 and loading * T <= 400.0
+                and (base, solvent) not in COUPLING_FORBIDDEN)
+
+    def objective(self, x):
+        cone, donor = COUPLING_LIGANDS[self.ligands[int(x[0])]]
+        pka, solubility = COUPLING_BASES[self.bases[int(x[1])]]
+        bp, polarity = COUPLING_SOLVENTS[self.solvents[int(x[2])]]
+        T, t, loading = x[3] + 273.15, x[4], x[5]
+        best_cone = 240.0 - 150.0 * polarity
+        dissolved = solubility + (1 - solubility) * polarity
+        activity = (math.exp(-((cone - best_cone) / 30.0) ** 2) * (0.4 + 0.6 * donor)
+                    * math.exp(-((pka - 12.0) / 1.2) ** 2) * dissolved)
+        k = 0.4 * activity * loading * math.exp(-7000 * (1 / T - 1 / 353.15))
+        k_side = 0.03 * (pka / 10.0) ** 4 * math.exp(-12000 * (1 / T - 1 / 353.15))
+        conversion = 1 - math.exp(-(k + k_side) * t)
+        return -(conversion * k / (k + k_side) - 0.03 * loading - 0.01 * t)
+
+    def reference(self):
+        return dense_reference(self, cont_steps=21)
+
+
 # ----------------------------------------------------------------------------------------------------------------
 # reaction kinetics in a flow reactor
 
@@ -353,4 +399,4 @@ def dense_reference(task, cont_steps: int, polish_from: int = 20) -> float:
 
 FAMILIES = ("smooth2", "smooth6", "smooth10", "mixed", "kinetics")
 TASKS = {t.name: t for t in (Camel2, Rosenbrock2, Hartmann6, Ellipsoid6, Ellipsoid10, Styblinski10, Solvent,
-                             Catalyst, Discrete, Consecutive, Parallel)}
+                             Catalyst, Discrete, Coupling, Consecutive, Parallel)}

@@ -39,6 +39,14 @@ FIT_MAX, FIT_BEST = 300, 100
 # and where the acquisition works) and a seeded random draw of the rest, new each ask. Exact conditioning costs n^3
 # for the Cholesky factor and (M, n) per candidate batch: a warm ask took 9.5 s at n = 5000 on 2 cores.
 COND_MAX, COND_BEST = 1000, 300
+# The marginal likelihood has a second optimum that explains the data as noise around a constant (output scale at its
+# floor, long length scales); fits from BoTorch's start (the middle of the bounds: length scales 10, output scale 50)
+# ended there on 8 random points of a smooth 3-D bowl and on m_coupling's seed 2 after 15 and 25 results, and such a
+# GP's expected improvement never left the first good combination of categories (benchmarks/README.md, "Stuck
+# campaigns on mixed spaces"). A fit whose kernel variance is below MIN_SIGNAL_TO_NOISE times its noise variance is
+# repeated from SHORT_START (length scales, output scale, noise; standardized units); the more likely one is kept.
+MIN_SIGNAL_TO_NOISE = 1.0
+SHORT_START = (0.3, 1.0, 1e-3)
 
 try:
     from botorch.exceptions import ModelFittingError
@@ -170,20 +178,45 @@ class GaussianProcess:
         if hyperparameters is not None:
             self.model.load_state_dict(dict(hyperparameters), strict=False)
         else:
-            initial = self.hyperparameters
             with torch.random.fork_rng(), warnings.catch_warnings():
                 torch.manual_seed(seed)
                 warnings.simplefilter("ignore")  # BoTorch's notes on fit retries and input scaling: handled here
-                try:
-                    fit_gpytorch_mll(ExactMarginalLogLikelihood(self.model.likelihood, self.model))
-                except ModelFittingError:
-                    # no attempt converged; the last one's point is kept when it is a usable model, else the start
-                    if not all(torch.isfinite(v).all() for v in self.hyperparameters.values()):
-                        self.model.load_state_dict(initial, strict=False)
+                self._fit()
+                if self.signal_to_noise() < MIN_SIGNAL_TO_NOISE:
+                    collapsed, likelihood_of_collapsed = self.hyperparameters, self.log_likelihood()
+                    short_start(self.model)
+                    self._fit()
+                    if self.log_likelihood() < likelihood_of_collapsed:
+                        self.model.load_state_dict(collapsed, strict=False)
         self.model.eval()
         self._posterior: Posterior | None = None
         # indices of the campaign's observations (X, y) are of; its maker sets them when X is a subset
         self.conditioned = np.arange(len(X))
+
+    def _fit(self) -> None:
+        """Hyperparameters by marginal likelihood from the model's current ones."""
+        initial = self.hyperparameters
+        try:
+            fit_gpytorch_mll(ExactMarginalLogLikelihood(self.model.likelihood, self.model))
+        except ModelFittingError:
+            # no attempt converged; the last one's point is kept when it is a usable model, else the start
+            if not all(torch.isfinite(v).all() for v in self.hyperparameters.values()):
+                self.model.load_state_dict(initial, strict=False)
+
+    def log_likelihood(self) -> float:
+        """The marginal log likelihood (per observation, with the noise prior) of the current hyperparameters."""
+        self.model.train()
+        with torch.no_grad():
+            value = ExactMarginalLogLikelihood(self.model.likelihood, self.model)(
+                self.model(*self.model.train_inputs), self.model.train_targets).item()
+        self.model.eval()
+        return value
+
+    def signal_to_noise(self) -> float:
+        """The kernel's prior variance at the training inputs (mean) over the noise variance."""
+        with torch.no_grad():
+            signal = self.model.covar_module(*self.model.train_inputs, diag=True).mean()
+            return float(signal / self.model.likelihood.noise.reshape(()))
 
     @property
     def hyperparameters(self) -> dict[str, torch.Tensor]:
@@ -214,6 +247,17 @@ class GaussianProcess:
         if self._posterior is None:
             self._posterior = Posterior(self.model)
         return self._posterior
+
+
+def short_start(model) -> None:
+    """Set the kernels' length scales, output scales and the noise of `model` to SHORT_START."""
+    lengthscale, outputscale, noise = SHORT_START
+    for module in model.covar_module.modules():
+        if isinstance(module, ScaleKernel):
+            module.outputscale = outputscale
+        elif getattr(module, "has_lengthscale", False):
+            module.lengthscale = lengthscale
+    model.likelihood.noise = noise
 
 
 class Posterior:

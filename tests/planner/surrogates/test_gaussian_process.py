@@ -204,6 +204,57 @@ def test_portfolio_leaves_its_first_model_only_on_clear_evidence(monkeypatch):
     assert meta["surrogate"] == "gp" and "kernel density not clearly better" in meta["surrogate_reason"]
 
 
+COUPLING = {"parameters": [{"name": "c", "type": "categorical", "options": ["a", "b", "c", "d"],
+                            "descriptors": {"a": [0.0, 0.2], "b": [0.4, 1.0], "c": [1.0, 0.1], "d": [0.6, 0.5]}}]
+            + [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(3)],
+            "objectives": [{"name": "y", "goal": "min"}], "constraints": ["x0 + x1 <= 1.5"],
+            "general": {"num_random_samples": 50}}
+
+
+def plateau_campaign(seed, asks):
+    """A mixed campaign whose results are a plateau near zero with one good result, in combination a (most
+    combinations of a coupling give no product): its proposals."""
+    rng = np.random.default_rng(0)
+    planner = Planner(COUPLING, seed=seed)
+    for i in range(12):
+        x = rng.uniform(0.0, 0.7, 3)
+        planner.tell({"c": "a" if i < 6 else "bcd"[i % 3], **{f"x{j}": float(v) for j, v in enumerate(x)},
+                      "y": -0.7 if i == 0 else float(rng.normal(0.0, 0.01))})
+    made = []
+    for _ in range(asks):
+        (proposal,) = planner.ask()
+        made.append(proposal)
+        planner.tell({**proposal.params, "y": float(rng.normal(0.0, 0.01)), "experiment_id": proposal.experiment_id})
+    return made
+
+
+def test_a_fit_that_explains_the_data_as_noise_is_repeated_from_short_length_scales(monkeypatch):
+    """From BoTorch's start the marginal likelihood of these 8 points of a smooth bowl ends in its all-noise optimum
+    (a near-constant model, whose expected improvement kept m_coupling's campaigns on their first good combination);
+    the repeated fit from SHORT_START is kept: more likely, and with more signal than noise."""
+    space = Planner(config3()).space
+    X = np.random.default_rng(2).uniform(0.0, 1.0, (8, 3))
+    y = np.array([bowl3({"x0": a, "x1": b, "x2": c}) for a, b, c in X])
+    fitted = GaussianProcess(space, X, y, seed=0)
+    monkeypatch.setattr(gp_module, "MIN_SIGNAL_TO_NOISE", 0.0)  # the first fit alone
+    first = GaussianProcess(space, X, y, seed=0)
+    assert first.signal_to_noise() < 0.01  # the collapse this guards against
+    assert fitted.signal_to_noise() > 1.0
+    assert fitted.log_likelihood() > first.log_likelihood() + 0.5
+
+
+def test_on_a_plateau_with_one_good_combination_the_campaign_tries_others():
+    """Mostly near-zero results and one good one in combination a: the planner does not stay on a, proposals are
+    feasible, and the same seed and data give the same proposals."""
+    made = plateau_campaign(seed=0, asks=5)
+    assert {p.params["c"] for p in made} - {"a"}
+    assert all(p.params["x0"] + p.params["x1"] <= 1.5 for p in made)
+    again = plateau_campaign(seed=0, asks=5)
+    for a, b in zip(made, again):
+        assert a.params["c"] == b.params["c"]
+        assert [a.params[f"x{i}"] for i in range(3)] == pytest.approx([b.params[f"x{i}"] for i in range(3)], abs=1e-9)
+
+
 def test_gp_proposals_survive_a_restart_exactly():
     """Hyperparameters are refitted from the same first observations after a restart, so a restored planner proposes
     what the running one does, also between refits (25 observations: fitted to the first 24)."""
