@@ -407,9 +407,13 @@ def test_stateless_recommend_reuses_a_fit_of_the_same_data_and_proposes_what_a_f
     assert fit_size(22) == fit_size(23) == 22
     planner = Planner(config("gp"), seed=1)
     planner.recommend(rows[:22])
-    fits = []
-    real_fit = gp_module.fit_gpytorch_mll
-    monkeypatch.setattr(gp_module, "fit_gpytorch_mll", lambda mll: fits.append(1) or real_fit(mll))
+    fits = []  # GPs made without hyperparameters: fitted
+    real_init = GaussianProcess.__init__
+
+    def counted(self, space, X, y, seed, descriptors=None, hyperparameters=None):
+        fits.extend([1] if hyperparameters is None else [])
+        real_init(self, space, X, y, seed, descriptors, hyperparameters)
+    monkeypatch.setattr(GaussianProcess, "__init__", counted)
     warm = planner.recommend(rows[:23])
     assert fits == []  # the fit of the first 22 was reused
     cold = Planner(config("gp"), seed=1).recommend(rows[:23])
