@@ -71,6 +71,7 @@ class GeneralSettings:
     softness: float = 1e-3
     feas_approach: str = "fwa"
     feas_param: float = 1.0
+    feas_model: str = "kde"
     auto_desc_gen: bool = False
     kernel_width: str = "auto"
     concrete_temperature: float = 0.0
@@ -82,13 +83,15 @@ _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
     "batches": (int,), "sampling_strategies": (int,), "num_random_samples": (int,),
     "acquisition_optimizer": (str,), "obj_transform": (str,), "feasible_fraction": (int, float),
     "random_seed": (int,), "max_rejection_draws": (int,), "softness": (int, float),
-    "feas_approach": (str,), "feas_param": (int, float), "auto_desc_gen": (bool,),
+    "feas_approach": (str,), "feas_param": (int, float), "feas_model": (str,),
+    "auto_desc_gen": (bool,),
     "kernel_width": (str,), "concrete_temperature": (int, float), "surrogate": (str,), "dist_param": (int, float),
 }
 # obj_transform: Gryffin's None (no transform) is our `identity`
 _GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"},
                     "obj_transform": {"sqrt", "cbrt", "square", "identity"},
-                    "feas_approach": {"fwa", "fia", "fca"}, "kernel_width": {"auto", "spacing", "gryffin"},
+                    "feas_approach": {"fwa", "fia", "fca"}, "feas_model": {"kde", "gp"},
+                    "kernel_width": {"auto", "spacing", "gryffin"},
                     "surrogate": {"portfolio", "kde", "gp", "auto"}}
 
 

@@ -6,12 +6,15 @@ acting as one prior pseudo-observation. The wide one (kernels as broad as the sp
 shared between options) has the constant prior pi = (n_ok + 1) / (n + 2); the narrow one (Gryffin's kernels, each
 option on its own) has the wide estimate as its prior. Near observations the narrow kernels decide, between them
 the wide ones extend what was seen, far from everything P = pi. Each estimate is 1 - alpha of the kernel
-acquisition with the failure labels as merits, so the same numerics (log space, no underflow) serve both.
+acquisition with the failure labels as merits, so the same numerics (log space, no underflow) serve both. With
+general.feas_model = gp a GP classifier of feasibility (`surrogates.gp_classifier`, Atlas' model) takes the wide
+estimate's place as the narrow kernels' prior.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Protocol
 
 import numpy as np
 import torch
@@ -29,22 +32,42 @@ def no_descriptors(space: SearchSpace) -> dict[int, None]:
     return {int(d): None for d in space.finite_idx}
 
 
+class Classifier(Protocol):
+    def probability(self, X: np.ndarray) -> np.ndarray: ...
+
+
+class WideKernels:
+    """P(feasible) from kernels as wide as the spacing of the data, descriptors shared, constant prior pi."""
+
+    def __init__(self, space: SearchSpace, X: np.ndarray, labels: np.ndarray, prior: float, feasible_fraction: float,
+                 generator: torch.Generator, descriptors: Mapping[int, np.ndarray] | None = None):
+        self._acquisition = Acquisition(KernelDensity(space, X, labels, feasible_fraction, generator,
+                                                      spacing_scaled=True, descriptors=descriptors), 1.0 - prior)
+
+    def probability(self, X: np.ndarray) -> np.ndarray:
+        return 1.0 - self._acquisition.evaluate(X)
+
+
 class FeasibilityModel:
     def __init__(self, space: SearchSpace, X: np.ndarray, failed: np.ndarray, feasible_fraction: float,
-                 generator: torch.Generator, descriptors: Mapping[int, np.ndarray] | None = None):
+                 generator: torch.Generator, descriptors: Mapping[int, np.ndarray] | None = None,
+                 classifier: Classifier | None = None):
+        """`classifier`: the prior of the narrow kernels (default: the wide kernel estimate)."""
         self.fraction_failed = float(failed.mean())
+        self.notes: dict[str, str] = {}  # what the planner records in proposal meta about this model (a fallback)
         self.prior = (len(failed) - failed.sum() + 1.0) / (len(failed) + 2.0)
         labels = failed.astype(float)
-        self._wide = Acquisition(KernelDensity(space, X, labels, feasible_fraction, generator, spacing_scaled=True,
-                                               descriptors=descriptors), 1.0 - self.prior)
+        self._wide = classifier if classifier is not None else WideKernels(space, X, labels, self.prior,
+                                                                           feasible_fraction, generator, descriptors)
         narrow = KernelDensity(space, X, labels, feasible_fraction, generator, descriptors=no_descriptors(space))
         self._narrow = (Acquisition(narrow, 0.0), Acquisition(narrow, 1.0))
 
     def probability(self, X: np.ndarray) -> np.ndarray:
         """(M, D) internal points -> (M,) P(feasible): Gryffin's narrow kernels, each option on its own, with the
-        wide estimate (kernels as wide as the data spacing, descriptors shared) as their prior instead of a constant:
-        near observations the narrow kernels decide, elsewhere the wide ones extend what was seen."""
-        prior = 1.0 - self._wide.evaluate(X)
+        wide estimate (kernels as wide as the data spacing, descriptors shared, or the GP classifier) as their
+        prior instead of a constant: near observations the narrow kernels decide, elsewhere the prior extends what was
+        seen."""
+        prior = self._wide.probability(X)
         alpha0, alpha1 = (a.evaluate(X) for a in self._narrow)  # S_fail/(S+u) and (S_fail+u)/(S+u)
         return 1.0 - alpha0 - (1.0 - prior) * (alpha1 - alpha0)
 

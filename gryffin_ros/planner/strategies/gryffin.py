@@ -135,12 +135,25 @@ class Planner(BasePlanner):
         return summary
 
     def _feasibility(self, observed: np.ndarray, generator: torch.Generator) -> FeasibilityModel | None:
-        """The model of unknown constraints, once some experiment has failed."""
+        """The model of unknown constraints, once some experiment has failed: Gryffin's narrow kernels over the wide
+        kernel estimate or (general.feas_model = gp) over a GP classifier, the kernel estimate if that cannot be
+        fitted (`FeasibilityModel.notes` says so)."""
         failed = np.array([o.failed for o in self.observations])
         if not failed.any():
             return None
         descriptors = {d: r.table for d, r in self.learned_descriptors(observed, failed.astype(float)).items()}
-        return FeasibilityModel(self.space, observed, failed, self.feasible_fraction.value, generator, descriptors)
+        classifier, notes = None, {}
+        if self.config.general.feas_model == "gp":
+            from ..surrogates.gp_classifier import ClassifierFitError, GPClassifier  # BoTorch, loaded when needed
+            seed = int(torch.randint(2**62, (1,), generator=generator))
+            try:
+                classifier = GPClassifier(self.space, observed, failed, seed, descriptors)
+            except ClassifierFitError as error:
+                notes = {"feas_model": "kde", "feas_model_reason": str(error)}
+        model = FeasibilityModel(self.space, observed, failed, self.feasible_fraction.value, generator, descriptors,
+                                 classifier)
+        model.notes = notes
+        return model
 
     def _away_from_failures(self, n: int, rng: np.random.Generator, observed: np.ndarray, chosen: np.ndarray,
                             feasibility: FeasibilityModel) -> np.ndarray:
@@ -205,9 +218,10 @@ class Planner(BasePlanner):
         if models.density is None:
             if feasibility is None:
                 return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n, {}
-            return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n, {}
+            return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n, dict(feasibility.notes)
         X, merits, descriptors, density = models.X, models.merits, models.descriptors, models.density
         gp, meta = self.surrogate_choice.choose(X, merits, successful, density, descriptors)
+        meta.update(feasibility.notes if feasibility is not None else {})
         report("optimizing", 0.0)
         start, exhaustive = self.start_points(rng, X[int(np.argmin(merits))], X)
         if gp is not None:

@@ -46,6 +46,7 @@ def test_config_from_yaml_and_json_files(tmp_path, unit_square_config):
     ({"general": {"batches": "2"}}, "'general.batches' has the wrong type"),
     ({"general": {"batches": 0}}, "'general.batches' must be at least 1"),
     ({"general": {"acquisition_optimizer": "lbfgs"}}, "'general.acquisition_optimizer' must be one of"),
+    ({"general": {"feas_model": "svm"}}, "'general.feas_model' must be one of ['gp', 'kde'], got 'svm'"),
     ({"general": {"feasible_fraction": 1.5}}, "must be in (0, 1]"),
     ({"general": {"auto_desc_gen": "yes"}}, "'general.auto_desc_gen' has the wrong type"),
     ({"general": {"batches": True}}, "'general.batches' has the wrong type"),
