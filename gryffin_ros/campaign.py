@@ -189,7 +189,7 @@ class Campaign:
             history = self._history
             return {
                 "campaign": self.name, "n_observations": len(history.observations),
-                "n_pending": len(history.pending), "n_failed": sum(o.failed for o in history.observations),
+                "n_pending": len(history.pending), "n_failed": history.n_failed,
                 "state": self._state,
                 "best": None if best is None else {"experiment_id": best.experiment_id, "params": best.params,
                                                    "objectives": best.objectives},

@@ -10,6 +10,7 @@ proposed, so a proposal that could not be stored leaves no trace to undo.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
@@ -25,11 +26,21 @@ class History:
     proposal_count: int = 0
 
     def __post_init__(self) -> None:
+        # derived once here and grown with add_observations (a campaign takes a snapshot per observation and reads
+        # the failure count with every status: neither walks all the observations again)
         self._ids = {o.experiment_id for o in self.observations if o.experiment_id is not None}
+        self._failed = sum(o.failed for o in self.observations)
+
+    @property
+    def n_failed(self) -> int:
+        """How many of the observations are failed experiments."""
+        return self._failed
 
     def snapshot(self) -> History:
         """A copy whose lists later additions here do not change (the observations themselves are shared)."""
-        return History(list(self.observations), dict(self.pending), self.ask_count, self.proposal_count)
+        other = copy.copy(self)
+        other.observations, other.pending, other._ids = list(self.observations), dict(self.pending), set(self._ids)
+        return other
 
     def reported(self, experiment_id: str | None) -> bool:
         return experiment_id is not None and experiment_id in self._ids
@@ -47,6 +58,7 @@ class History:
         """Observations whose ids are new (`check_new`): appended, and no longer pending."""
         for o in observations:
             self.observations.append(o)
+            self._failed += o.failed
             if o.experiment_id is not None:
                 self._ids.add(o.experiment_id)
                 self.pending.pop(o.experiment_id, None)
