@@ -8,7 +8,7 @@
 - a Gryffin 1.0 script's loop: stateless `recommend` on a list that grows by one, n = 100 ... 119, d = 2, on one
   planner (it reuses the fits of the same first observations) and on a fresh planner per call (nothing to reuse);
 - asks on issue #37's mixed Suzuki-like space (3 catalysts, 4 solvents with descriptors, 3 continuous conditions,
-  T below the solvent's boiling point, Chimera yield then cost) at n = 16, 50, 100 (median of 5 warm asks).
+  T below the solvent's boiling point, Chimera yield then cost) at n = 5, 16, 50, 100 (median of 5 warm asks).
 
     .venv/bin/python benchmarks/lab_scale.py [--surrogate NAME] [--repeats 3] [--cases warm,...,mixed]
                                              [--out benchmarks/results/lab_scale.md]
@@ -33,7 +33,7 @@ from gryffin_ros.planner import Planner
 WARM_ASKS = 10
 # issue #37's Suzuki-like campaign: 3 catalysts, 4 solvents with descriptors, 3 continuous conditions, a constraint
 # on a solvent's boiling point, Chimera yield then cost
-MIXED_SIZES, MIXED_ASKS = (16, 50, 100), 5
+MIXED_SIZES, MIXED_ASKS = (5, 16, 50, 100), 5
 SOLVENTS = {"THF": [66.0, 7.5], "dioxane": [101.0, 2.2], "toluene": [111.0, 2.4], "DMF": [153.0, 36.7]}
 MIXED = {
     "parameters": [{"name": "catalyst", "type": "categorical", "options": ["Pd(PPh3)4", "Pd(dppf)Cl2", "XPhos Pd G3"]},
