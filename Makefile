@@ -2,7 +2,9 @@
 # refreshes the local virtual environment with exactly the package set of requirements.lock (the set the suite
 # passed with), then the package itself with its test, ROS 2, interface-generator, colcon (workspace), recording and
 # molecules (RDKit) extras, then
-# builds the typed interfaces gryffin_ros_msgs into it (msg_schemas/build.sh).
+# builds the typed interfaces gryffin_ros_msgs into it (gryffin_ros_msgs/build.sh). The repository holds the two ROS 2
+# packages side by side, as a colcon workspace wants them: gryffin_ros/ (the Python package in gryffin_ros/gryffin_ros)
+# and gryffin_ros_msgs/.
 # `make lock` regenerates requirements.lock: a fresh environment resolved from the deliberate pins of
 # constraints.txt alone, frozen.
 VENV ?= .venv
@@ -10,17 +12,17 @@ PYTHON ?= python3
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 LOCK := requirements.lock
-EXTRAS := .[test,ros,interfaces,workspace,record,molecules]
+EXTRAS := ./gryffin_ros[test,ros,interfaces,workspace,record,molecules]
 MSGS := $(VENV)/.interfaces
 
 # DDS stays on loopback in every process started from here (SPEC section 6), with the fast-discovery profile.
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
-export FASTRTPS_DEFAULT_PROFILES_FILE := $(CURDIR)/gryffin_ros/resources/fastdds_profile.xml
+export FASTRTPS_DEFAULT_PROFILES_FILE := $(CURDIR)/gryffin_ros/gryffin_ros/resources/fastdds_profile.xml
 export RMW_IMPLEMENTATION := rmw_fastrtps_cpp
 
 .PHONY: venv demo test check lint lock
 
-$(STAMP): setup.py constraints.txt $(LOCK)
+$(STAMP): gryffin_ros/setup.py constraints.txt $(LOCK)
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet -c $(LOCK) pip
 	$(PY) -m pip install --quiet -c $(LOCK) torch
@@ -28,8 +30,8 @@ $(STAMP): setup.py constraints.txt $(LOCK)
 	touch $(STAMP)
 
 # the typed interfaces gryffin_ros_msgs, generated into the same environment (cmake and a C/C++ compiler needed)
-$(MSGS): $(STAMP) msg_schemas/build.sh msg_schemas/CMakeLists.txt msg_schemas/package.xml $(wildcard msg_schemas/msg/*.msg msg_schemas/srv/*.srv msg_schemas/action/*.action)
-	msg_schemas/build.sh $(VENV)
+$(MSGS): $(STAMP) gryffin_ros_msgs/build.sh gryffin_ros_msgs/CMakeLists.txt gryffin_ros_msgs/package.xml $(wildcard gryffin_ros_msgs/msg/*.msg gryffin_ros_msgs/srv/*.srv gryffin_ros_msgs/action/*.action)
+	gryffin_ros_msgs/build.sh $(VENV)
 	touch $(MSGS)
 
 lock:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[1] / "gryffin_ros"
+PACKAGE = Path(__file__).resolve().parents[1] / "gryffin_ros" / "gryffin_ros"
 
 
 def imported_modules(path: Path) -> set[str]:
@@ -54,7 +54,7 @@ def test_only_the_nodes_import_rclpy():
 
 
 def test_the_import_reader_resolves_relative_imports():
-    # gryffin_ros/planner/acquisition/gp.py: "from ..surrogates.gaussian_process import CHUNK, GaussianProcess"
+    # planner/acquisition/gp.py: "from ..surrogates.gaussian_process import CHUNK, GaussianProcess"
     found = imported_modules(PACKAGE / "planner" / "acquisition" / "gp.py")
     assert "gryffin_ros.planner.surrogates.gaussian_process" in found
 

@@ -16,7 +16,7 @@ pytestmark = pytest.mark.skipif(REASON is not None, reason=f"network namespaces:
 
 CONFIG = share_path("examples") / "flow_reactor.yaml"
 BUDGET = 16
-CUT_S = 12.0  # longer than the DDS lease (10 s in gryffin_ros/resources/fastdds_profile.xml): peers drop each other
+CUT_S = 12.0  # longer than the DDS lease (10 s in the package's resources/fastdds_profile.xml): peers drop each other
 HANG_S = 180.0
 
 

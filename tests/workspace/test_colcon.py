@@ -1,5 +1,6 @@
-"""The repository as a colcon workspace's source (README, "In a colcon workspace"): `colcon build` of both packages
-(gryffin_ros_msgs from msg_schemas/ with ament_cmake, gryffin_ros with ament_python) in an environment holding the ROS
+"""The repository as a colcon workspace's source (README, "In a colcon workspace"): a bare `colcon build` finds and
+builds both packages (gryffin_ros_msgs/ with ament_cmake, gryffin_ros/ with ament_python) and nothing else of the
+repository, in an environment holding the ROS
 2 wheels and colcon, no apt ROS; after `source install/setup.bash` the planner node runs from the installed layout
 (`install/gryffin_ros/lib/gryffin_ros/planner_node`, what `ros2 run gryffin_ros planner_node` starts) with the installed
 params file and example, and serves a typed Recommend goal to a client that imports the installed packages.
@@ -29,7 +30,7 @@ CLIENT = Path(__file__).with_name("recommend_client.py")
 BUILD_TIMEOUT_S = 1200.0
 HANG_S = 180.0
 # the commands of the README's section
-BUILD = ["colcon", "build", "--base-paths", "src", "src/gryffin_ros/msg_schemas"]
+BUILD = ["colcon", "build"]
 
 
 def underlay_environment(log_dir: Path) -> dict[str, str]:
@@ -79,6 +80,8 @@ def workspace(tmp_path_factory):
 
 def check_the_ros_layout(root: Path, env: dict[str, str]) -> None:
     install = root / "install"
+    # exactly the two packages: colcon found both folders and no other folder of the repository as a package
+    assert {p.name for p in install.iterdir() if p.is_dir()} == {"gryffin_ros", "gryffin_ros_msgs"}
     for package in ("gryffin_ros", "gryffin_ros_msgs"):
         assert (install / package / "share/ament_index/resource_index/packages" / package).is_file()
         assert (install / package / "share" / package / "package.xml").is_file()

@@ -11,7 +11,7 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def test_package_manifests_are_format_3_with_the_build_types_ros_expects():
-    manifests = {"gryffin_ros": REPO / "package.xml", "gryffin_ros_msgs": REPO / "msg_schemas/package.xml"}
+    manifests = {name: REPO / name / "package.xml" for name in ("gryffin_ros", "gryffin_ros_msgs")}
     build_types = {"gryffin_ros": "ament_python", "gryffin_ros_msgs": "ament_cmake"}
     for name, path in manifests.items():
         package = parse_package(str(path))

