@@ -18,7 +18,7 @@ from typing import Any
 import yaml
 
 from . import molecules
-from .constraints.plugins import expression_text
+from .constraints.specs import ConstraintSpec, constraint_specs
 from .errors import ConfigError
 from .molecules import MoleculeCache, Molecules
 from .notices import note_no_effect
@@ -101,7 +101,7 @@ class PlannerConfig:
     space: SearchSpace
     objectives: list[Objective]
     general: GeneralSettings
-    constraint_specs: list[Any] = field(default_factory=list)
+    constraint_specs: list[ConstraintSpec] = field(default_factory=list)
     raw: dict = field(default_factory=dict)
     base_dir: Path | None = None  # relative file names in the config (lookup tables) are taken from here
 
@@ -249,19 +249,8 @@ def _objectives(spec: Any, parameter_names: tuple[str, ...]) -> list[Objective]:
     return out
 
 
-def _with_base_dir(constraints: list[Any], base_dir: Path | None) -> list[Any]:
-    """Constraint specs with relative `file` options of plugins made absolute against the config's folder."""
-    out = []
-    for spec in constraints:
-        options = spec.get("options") if isinstance(spec, Mapping) else None
-        if base_dir is not None and isinstance(options, Mapping) and isinstance(options.get("file"), str) \
-                and not Path(options["file"]).is_absolute():
-            spec = {**spec, "options": {**options, "file": str(base_dir / options["file"])}}
-        out.append(spec)
-    return out
-
-
-def _molecules(raw: dict, base_dir: Path | None, cache: MoleculeCache) -> dict[str, Molecules]:
+def _molecules(raw: dict, base_dir: Path | None, cache: MoleculeCache, constraints: list[ConstraintSpec]
+               ) -> dict[str, Molecules]:
     """What RDKit computes for the categorical parameters whose options are SMILES, by parameter name. Options read
     from a CSV/SDF file are written into `raw` as option -> SMILES, so the config's hash and the stored config hold
     the molecules themselves."""
@@ -269,18 +258,15 @@ def _molecules(raw: dict, base_dir: Path | None, cache: MoleculeCache) -> dict[s
     found: dict[str, tuple[Mapping, dict[str, str]]] = {}
     for i, spec in enumerate(specs):
         if isinstance(spec, Mapping) and spec.get("type") == "categorical" and isinstance(spec.get("name"), str):
-            smiles = molecules.smiles_options(spec, base_dir)
+            smiles = molecules.smiles_options(spec, base_dir, cache)
             if smiles is not None:
                 if isinstance(spec.get("options"), str):
                     specs[i] = spec = {**spec, "options": smiles}
                 found[spec["name"]] = (spec, smiles)
     if not found:
         return {}
-    constraints = raw.get("constraints") if isinstance(raw.get("constraints"), list) else []
-    texts = [expression_text(c) or expression_text(c.get("options") if isinstance(c, Mapping)
-                                                    and c.get("plugin") == "expression" else None)
-             for c in constraints]
-    patterns = molecules.substructure_patterns([t for t in texts if t is not None], set(found))
+    texts = [c.expression for c in constraints if isinstance(c.expression, str)]
+    patterns = molecules.substructure_patterns(texts, set(found))
     return {name: molecules.compute(name, smiles, molecules.descriptor_columns(spec), patterns.get(name, {}), cache)
             for name, (spec, smiles) in found.items()}
 
@@ -299,15 +285,14 @@ def load_config(source: Mapping | str | Path, base_dir: str | Path | None = None
     if "parameters" not in raw:
         raise ConfigError("config has no 'parameters'")
     base = Path(base_dir) if base_dir is not None else None
-    space = SearchSpace.from_config(raw["parameters"], _molecules(raw, base, molecule_cache or MoleculeCache()))
+    constraints = constraint_specs(raw.get("constraints") or [], base)
+    space = SearchSpace.from_config(raw["parameters"], _molecules(raw, base, molecule_cache or MoleculeCache(),
+                                                                  constraints))
     objectives = _objectives(raw.get("objectives"), space.names)
     general = _general(raw.get("general"))
     _gryffin_section("database", raw.get("database"), GRYFFIN_DATABASE_KEYS, _NO_DATABASE)
     _gryffin_section("model", raw.get("model"), GRYFFIN_MODEL_KEYS, _NO_BNN)
-    constraints = raw.get("constraints") or []
-    if not isinstance(constraints, list):
-        raise ConfigError("'constraints' must be a list")
     name = raw.get("name", "campaign")
     if not isinstance(name, str) or not name.strip() or "/" in name or "\\" in name:
         raise ConfigError(f"'name' must be a non-empty string without path separators, got {name!r}")
-    return PlannerConfig(name, space, objectives, general, _with_base_dir(constraints, base), raw, base)
+    return PlannerConfig(name, space, objectives, general, constraints, raw, base)

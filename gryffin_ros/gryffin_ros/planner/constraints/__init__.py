@@ -8,11 +8,12 @@ from .expressions import Expression
 from .geometry import line_limits
 from .known import KnownConstraints
 from .named import NamedConstraint, vectorized
-from .plugins import PLUGIN_GROUP, constraint_from_spec, expression_text, load_plugin
+from .plugins import PLUGIN_GROUP, constraint_from_spec, load_plugin
 from .region import ENUMERATION_LIMIT, FeasibleFraction, estimate_feasible_fraction, vacuous_constraints
+from .specs import ConstraintSpec, constraint_specs
 
 __all__ = [
-    "ENUMERATION_LIMIT", "PLUGIN_GROUP", "Expression", "FeasibleFraction", "KnownConstraints", "LinearEqualities",
-    "NamedConstraint", "constraint_from_spec", "estimate_feasible_fraction", "expression_text", "line_limits",
-    "load_plugin", "vacuous_constraints", "vectorized",
+    "ENUMERATION_LIMIT", "PLUGIN_GROUP", "ConstraintSpec", "Expression", "FeasibleFraction", "KnownConstraints",
+    "LinearEqualities", "NamedConstraint", "constraint_from_spec", "constraint_specs", "estimate_feasible_fraction",
+    "line_limits", "load_plugin", "vacuous_constraints", "vectorized",
 ]

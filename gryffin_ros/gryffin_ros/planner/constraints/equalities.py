@@ -33,7 +33,7 @@ from ..space import SearchSpace
 from ..suggest import suggestion
 from .expressions import NotLinear, difference, linear_form, parse
 from .named import NamedConstraint
-from .plugins import expression_text
+from .specs import ConstraintSpec
 
 # Relative tolerance when checking that a reported observation satisfies the equalities.
 OBSERVATION_TOLERANCE = 1e-6
@@ -62,21 +62,23 @@ class LinearEqualities:
 
     # ---- building --------------------------------------------------------------------------------------------
     @classmethod
-    def split(cls, specs: Sequence[Any], space: SearchSpace) -> tuple[LinearEqualities | None, list[Any]]:
-        """Config constraint entries -> (the equalities or None, the other entries plus the mixtures' bounds)."""
+    def split(cls, specs: Sequence[ConstraintSpec | Any], space: SearchSpace
+              ) -> tuple[LinearEqualities | None, list[ConstraintSpec]]:
+        """Config constraint specs -> (the equalities or None, the other specs plus the mixtures' bounds)."""
         continuous = {p.name for p in space.parameters if p.kind == "continuous"}
         periodic = {p.name for p in space.parameters if p.kind == "continuous" and p.periodic}
         every = set(space.names)
         rows: list[tuple[dict[str, float], float, str]] = []
-        rest: list[Any] = []
-        for position, spec in enumerate(specs):
-            where = f"constraints[{position}]"
-            if isinstance(spec, Mapping) and "mixture" in spec:
-                mixture_rows, bounds = cls._mixture(spec, where, continuous)
+        rest: list[ConstraintSpec] = []
+        specs = [ConstraintSpec.of(s, i) for i, s in enumerate(specs)]
+        for spec in specs:
+            where = spec.where
+            if spec.mixture is not None:
+                mixture_rows, bounds = cls._mixture(spec, continuous)
                 rows += mixture_rows
-                rest += bounds
+                rest += [ConstraintSpec(spec.position, expression=bound) for bound in bounds]
                 continue
-            text = expression_text(spec)
+            text = spec.expression if isinstance(spec.expression, str) else None
             sides = _equality_sides(text) if text is not None else None
             if sides is None:
                 rest.append(spec)
@@ -103,7 +105,7 @@ class LinearEqualities:
                 raise ConfigError(f"{where} '{text}': no parameter is left after simplification")
             rows.append((coefs, cb - ca, text))
         if not rows:
-            return None, list(specs)
+            return None, specs
         used = {k for coefs, _, _ in rows for k in coefs}
         if used & periodic:
             raise ConfigError(f"equality constraints on periodic parameters {sorted(used & periodic)} are not "
@@ -111,11 +113,9 @@ class LinearEqualities:
         return cls._solve(rows, space), rest
 
     @staticmethod
-    def _mixture(spec: Mapping, where: str, continuous: set[str]) -> tuple[list, list[str]]:
-        unknown = set(spec) - {"mixture", "name"}
-        body = spec["mixture"]
-        if unknown or not isinstance(body, Mapping):
-            raise ConfigError(f"{where}: a mixture is {{mixture: {{components: [...], total: 1, bounds: {{...}}}}}}")
+    def _mixture(spec: ConstraintSpec, continuous: set[str]) -> tuple[list, list[str]]:
+        """A mixture's equation (its components sum to the total) and its components' bounds as expressions."""
+        where, body = spec.where, spec.mixture
         extra = set(body) - {"components", "total", "bounds"}
         if extra:
             raise ConfigError(f"{where}: unknown mixture key(s) {sorted(extra)}; use components, total, bounds")
@@ -142,7 +142,7 @@ class LinearEqualities:
                                for v in pair) or pair[0] > pair[1]):
                 raise ConfigError(f"{where}: mixture bound for '{name}' must be [low, high] with low <= high")
             extra_constraints.append(f"{float(pair[0])!r} <= {name} <= {float(pair[1])!r}")
-        text = str(spec.get("name") or f"{' + '.join(components)} == {float(total)!r}")
+        text = spec.name or f"{' + '.join(components)} == {float(total)!r}"
         return [({c: 1.0 for c in components}, float(total), text)], extra_constraints
 
     @classmethod

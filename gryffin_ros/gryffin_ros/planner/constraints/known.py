@@ -12,7 +12,8 @@ from ..errors import ConfigError, ConstraintError
 from ..space import Parameter, SearchSpace
 from .expressions import linear_inequalities
 from .named import NamedConstraint, callable_constraint
-from .plugins import constraint_from_spec, expression_text
+from .plugins import constraint_from_spec
+from .specs import ConstraintSpec
 
 
 class KnownConstraints:
@@ -30,7 +31,7 @@ class KnownConstraints:
         self._halfspaces: tuple[tuple[np.ndarray, np.ndarray, bool] | None] | None = None  # computed once
 
     @classmethod
-    def build(cls, space: SearchSpace, specs: Sequence[Any] = (),
+    def build(cls, space: SearchSpace, specs: Sequence[ConstraintSpec | Any] = (),
               callables: Callable | Sequence[Callable] | None = None,
               parameters: Sequence[Parameter] | None = None, first: Sequence[NamedConstraint] = (),
               complete_columns: Callable[[Mapping[str, np.ndarray]], Mapping[str, np.ndarray]] | None = None,
@@ -39,12 +40,12 @@ class KnownConstraints:
         from equalities); `first`: constraints checked before the specs' (the solved parameters' bounds);
         `complete_columns` / `complete_row` as in the constructor."""
         by_name = {p.name: p for p in (space.parameters if parameters is None else parameters)}
-        constraints = [constraint_from_spec(s, i, by_name) for i, s in enumerate(specs)]
+        specs = [ConstraintSpec.of(s, i) for i, s in enumerate(specs)]
+        constraints = [constraint_from_spec(s, s.position, by_name) for s in specs]
         continuous = {p.name for p in space.parameters if p.kind == "continuous"}
         for spec, constraint in zip(specs, constraints):
-            text = expression_text(spec)
-            if text is not None:
-                constraint.linear = linear_inequalities(text, continuous)
+            if isinstance(spec.expression, str):
+                constraint.linear = linear_inequalities(spec.expression, continuous)
         if callables is not None:
             fns = [callables] if callable(callables) else list(callables)
             for i, fn in enumerate(fns):

@@ -24,6 +24,7 @@ from ..suggest import suggestion
 from .expressions import Expression
 from .literals import matches_option, option_list, unknown_option
 from .named import NamedConstraint
+from .specs import EXPRESSION_OPTIONS, ConstraintSpec
 
 PLUGIN_GROUP = "gryffin_ros.constraints"
 
@@ -31,7 +32,7 @@ Parameters = Mapping[str, Parameter]  # every parameter a constraint may name, b
 
 
 def expression_constraint(options: Mapping[str, Any], parameters: Parameters) -> NamedConstraint:
-    unknown = sorted(set(options) - {"expression", "name"}) if isinstance(options, Mapping) else []
+    unknown = sorted(set(options) - EXPRESSION_OPTIONS) if isinstance(options, Mapping) else []
     if unknown:
         raise ConfigError(f"expression constraint: unknown option(s) {unknown}; it takes only 'expression'")
     text = options.get("expression") if isinstance(options, Mapping) else None
@@ -151,39 +152,22 @@ def load_plugin(name: str, options: Mapping[str, Any], parameters: Parameters) -
     return NamedConstraint(getattr(constraint, "name", name), constraint, getattr(constraint, "evaluate_columns", None))
 
 
-def expression_text(spec: Any) -> str | None:
-    """The expression of a config entry given as a string or ``{expression: ...}`` (None for plugins and others)."""
-    if isinstance(spec, str):
-        return spec
-    if isinstance(spec, Mapping) and "plugin" not in spec and isinstance(spec.get("expression"), str):
-        return spec["expression"]
-    return None
-
-
-def constraint_from_spec(spec: Any, position: int, parameters: Parameters) -> NamedConstraint:
-    """A config entry: an expression string, ``{expression: ...}`` or ``{plugin: NAME, options: {...}}``."""
-    if isinstance(spec, str):
-        return expression_constraint({"expression": spec}, parameters)
-    if isinstance(spec, Mapping):
-        unknown = set(spec) - {"plugin", "options", "expression", "name"}
-        if unknown:
-            raise ConfigError(f"constraints[{position}]: unknown key(s) {sorted(unknown)}")
-        if "expression" in spec and "plugin" in spec:
-            raise ConfigError(f"constraints[{position}]: give 'expression' or 'plugin', not both")
-        if "expression" in spec and "options" in spec:
-            raise ConfigError(f"constraints[{position}]: 'options' belong to a plugin; an expression takes none")
-        if "expression" not in spec and not isinstance(spec.get("plugin"), str):
-            raise ConfigError(f"constraints[{position}]: needs an 'expression' string or a 'plugin' name")
-        try:
-            if "expression" in spec:
-                constraint = expression_constraint(spec, parameters)
-            else:
-                constraint = load_plugin(spec["plugin"], spec.get("options", {}), parameters)
-        except ConfigError as exc:
-            if "name" not in spec:
-                raise
-            raise ConfigError(f"constraints[{position}] ('{spec['name']}'): {exc}") from None
-        if "name" in spec:
-            constraint.name = str(spec["name"])
-        return constraint
-    raise ConfigError(f"constraints[{position}] must be an expression string or a mapping, got {type(spec).__name__}")
+def constraint_from_spec(spec: ConstraintSpec | Any, position: int, parameters: Parameters) -> NamedConstraint:
+    """The constraint of a config entry: a `ConstraintSpec`, or an entry as written (an expression string,
+    ``{expression: ...}`` or ``{plugin: NAME, options: {...}}``), typed first; `position` is its place in the list."""
+    spec = ConstraintSpec.of(spec, position)
+    if spec.mixture is not None:
+        raise ConfigError(f"{spec.where}: a mixture is an equality of continuous parameters, solved by the planner "
+                          "(LinearEqualities), not a constraint to evaluate")
+    try:
+        if spec.plugin is None:
+            constraint = expression_constraint({"expression": spec.expression}, parameters)
+        else:
+            constraint = load_plugin(spec.plugin, spec.options, parameters)
+    except ConfigError as exc:
+        if spec.name is None:
+            raise
+        raise ConfigError(f"{spec.where} ('{spec.name}'): {exc}") from None
+    if spec.name is not None:
+        constraint.name = spec.name
+    return constraint
