@@ -463,3 +463,27 @@ def test_a_restarted_campaign_takes_molecule_descriptors_from_its_store_without_
         assert proposal.params["ligand"] in ("PPh3", "PMe3")
     with pytest.raises(ConfigError, match=r"pip install gryffin_ros\[molecules\]"):
         Campaign(MOLECULES, tmp_path / "new.sqlite")  # a new store has nothing kept: RDKit is really unavailable
+
+
+def test_a_restarted_campaign_reads_its_sdf_options_from_its_store_without_rdkit(tmp_path, monkeypatch):
+    chem = pytest.importorskip("rdkit.Chem")
+    writer = chem.SDWriter(str(tmp_path / "ligands.sdf"))
+    for name, smiles in (("PPh3", "c1ccc(P(c2ccccc2)c2ccccc2)cc1"), ("PMe3", "CP(C)C"), ("pyridine", "c1ccncc1")):
+        molecule = chem.MolFromSmiles(smiles)
+        molecule.SetProp("_Name", name)
+        writer.write(molecule)
+    writer.close()
+    config = {**MOLECULES, "parameters": [{"name": "ligand", "type": "categorical", "options": "ligands.sdf"},
+                                          MOLECULES["parameters"][1]]}
+    (tmp_path / "c.yaml").write_text(json.dumps(config))  # JSON is YAML; the SDF is named relative to it
+    with Campaign(tmp_path / "c.yaml", tmp_path / "c.sqlite", seed=0) as campaign:
+        smiles = campaign.config.space.parameters[0].smiles
+        campaign.observe(report(campaign.propose(1)[0]))
+    monkeypatch.setitem(sys.modules, "rdkit", None)
+    with Campaign(tmp_path / "c.yaml", tmp_path / "c.sqlite") as restarted:
+        assert restarted.config.space.parameters[0].smiles == smiles and list(smiles) == ["PPh3", "PMe3", "pyridine"]
+        assert restarted.n_observations == 1
+    with (tmp_path / "ligands.sdf").open("a") as handle:  # another file: read anew, which needs RDKit
+        handle.write("\n")
+    with pytest.raises(ConfigError, match=r"pip install gryffin_ros\[molecules\]"):
+        Campaign(tmp_path / "c.yaml", tmp_path / "c.sqlite")

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import ast
 import csv
+import hashlib
 import re
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
@@ -69,6 +70,19 @@ class MoleculeCache:
     def put(self, key: tuple[str, str], value: float) -> None:
         self.values[key] = self.computed[key] = float(value)
 
+    # An SDF file's molecules, by the digest of its bytes: (SMILES, "sdf:DIGEST:NAME") -> the record's position, so
+    # that a campaign restarted from its store reads its SDF options without RDKit.
+    def sdf(self, digest: str) -> dict[str, str] | None:
+        """The option -> SMILES of the SDF file of this digest, in file order, or None when it was never read."""
+        prefix = f"sdf:{digest}:"
+        found = sorted((position, feature[len(prefix):], smiles) for (smiles, feature), position in self.values.items()
+                       if feature.startswith(prefix))
+        return {name: smiles for _, name, smiles in found} or None
+
+    def put_sdf(self, digest: str, options: Mapping[str, str]) -> None:
+        for position, (name, smiles) in enumerate(options.items()):
+            self.put((smiles, f"sdf:{digest}:{name}"), position)
+
 
 def rdkit(why: str) -> Any:
     """The `rdkit.Chem` module, or a ConfigError naming the extra to install."""
@@ -127,14 +141,15 @@ def properties_of(mol: Any) -> dict[str, float]:
     return out
 
 
-def smiles_options(spec: Mapping[str, Any], base_dir: Path | None) -> dict[str, str] | None:
+def smiles_options(spec: Mapping[str, Any], base_dir: Path | None, cache: MoleculeCache | None = None
+                   ) -> dict[str, str] | None:
     """A categorical parameter's options as option -> SMILES (given as a mapping, or a CSV/SDF file name), or None
-    when they are plain names."""
+    when they are plain names. An SDF file read once is kept in `cache` by the digest of its bytes."""
     options = spec.get("options")
     where = f"parameter '{spec.get('name')}'"
     if isinstance(options, str):
         path = Path(options) if base_dir is None or Path(options).is_absolute() else base_dir / options
-        options = _read_sdf(path, where) if path.suffix.lower() == ".sdf" else _read_csv(path, where)
+        options = _read_sdf(path, where, cache) if path.suffix.lower() == ".sdf" else _read_csv(path, where)
     if not isinstance(options, Mapping):
         return None
     for option, smiles in options.items():
@@ -173,11 +188,17 @@ def _read_csv(path: Path, where: str) -> dict[str, str]:
     return out
 
 
-def _read_sdf(path: Path, where: str) -> dict[str, str]:
-    """An SDF file: each record's name (its first line) -> its canonical SMILES (read with RDKit at every load)."""
+def _read_sdf(path: Path, where: str, cache: MoleculeCache | None = None) -> dict[str, str]:
+    """An SDF file: each record's name (its first line) -> its canonical SMILES, read with RDKit unless `cache`
+    holds a file of the same bytes."""
+    try:
+        digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError as exc:
+        raise ConfigError(f"{where}: cannot read '{path}': {exc.strerror or exc}") from None
+    known = cache.sdf(digest) if cache is not None else None
+    if known is not None:
+        return known
     chem = rdkit(f"{where}: reading '{path}'")
-    if not path.is_file():
-        raise ConfigError(f"{where}: cannot read '{path}': no such file")
     out: dict[str, str] = {}
     for index, mol in enumerate(chem.SDMolSupplier(str(path))):
         if mol is None:
@@ -187,6 +208,8 @@ def _read_sdf(path: Path, where: str) -> dict[str, str]:
             raise ConfigError(f"{where}: record {index + 1} of '{path}' needs a name of its own (its first line), "
                               f"got {name!r}")
         out[name] = chem.MolToSmiles(mol)
+    if cache is not None:
+        cache.put_sdf(digest, out)
     return out
 
 
