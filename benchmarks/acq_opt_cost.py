@@ -6,7 +6,7 @@ strategy (start points + Adam/Hill or genetic refinement), for lambda = -1 and +
 both strategies, selection). Published: Gryffin's `proposals_opt` time per strategy, mean of 20 repeats, from
 ../shared/data/gkc_benchmarks/comp-scaling-acq-opt/DERIVED_timings.json (another machine; TensorFlow-era Gryffin).
 
-    python benchmarks/acq_opt_cost.py [--repeats 5] [--data ../shared/data] [--out benchmarks/results]
+    python -m benchmarks.acq_opt_cost [--repeats 5] [--data ../shared/data] [--out benchmarks/results]
 """
 
 from __future__ import annotations
@@ -107,7 +107,7 @@ def main() -> None:
                                 f"{row['published_plus1'] or float('nan'):.1f} |")
                     print(rows[-1], flush=True)
     lines = ["# Acquisition-optimization cost (paper SI scaling study)", "",
-             f"Command: `python benchmarks/acq_opt_cost.py --repeats {args.repeats}` (one thread, 2-core machine). "
+             f"Command: `python -m benchmarks.acq_opt_cost --repeats {args.repeats}` (one thread, 2-core machine). "
              "Seconds, mean over repeats. Ours: acquisition optimization for one strategy (start points + "
              "refinement) and the whole ask of 2 proposals; published: Gryffin's acquisition optimization per "
              "strategy, 20 repeats, another machine.", "",

@@ -1,12 +1,14 @@
 """The paper's two applications, many seeds, next to the paper's own runs (../shared/data):
 
-- flow reactor (examples/flow_reactor.yaml, BNN emulator): best-so-far by the Chimera hierarchy (X1 + X2 >= 0.9, then
-  cost); reported: cost of the best experiment at iteration 100 and how many runs reached X1 + X2 >= 0.9.
-- redox candidates (examples/redox_flow_battery.yaml, DFT lookup): experiments until the best synthesizable candidate
-  (R1_0, R3_7, R4_7, R5_0) is measured, with dynamic descriptors, static descriptors and none (the example's three
-  sampling strategies), and `dynamic-2s`: dynamic descriptors with the paper's two alternating strategies.
+- flow reactor (gryffin_ros/examples/flow_reactor.yaml, BNN emulator): best-so-far by the Chimera hierarchy
+  (X1 + X2 >= 0.9, then cost); reported: cost of the best experiment at iteration 100 and how many runs reached
+  X1 + X2 >= 0.9.
+- redox candidates (gryffin_ros/examples/redox_flow_battery.yaml, DFT lookup): experiments until the best
+  synthesizable candidate (R1_0, R3_7, R4_7, R5_0) is measured, with dynamic descriptors, static descriptors and
+  none (the example's three sampling strategies), and `dynamic-2s`: dynamic descriptors with the paper's two
+  alternating strategies.
 
-    python benchmarks/applications.py [--seeds 20] [--processes 2] [--data ../shared/data] [--out benchmarks/results]
+    python -m benchmarks.applications [--seeds 20] [--processes 2] [--data ../shared/data] [--out benchmarks/results]
         [--flow default,genetic,adam,gp,auto]   flow-reactor variants: the example as shipped (the default
                                                 surrogate, Genetic); the kernel density (the paper's model) with the
                                                 Genetic or the Adam optimizer; the GP or auto surrogate with Adam

@@ -1,7 +1,7 @@
 """Median ask() latency of the Planner vs the number of observations n and the dimension d (paper SI setup: all
 parameters continuous in [0, 1], optionally constrained by sum(x) <= 0.5 d), for the Adam and Genetic optimizers.
 
-    python benchmarks/ask_latency.py [--repeats 5] [--surrogate kde] [--out benchmarks/results/ask_latency.md]
+    python -m benchmarks.ask_latency [--repeats 5] [--surrogate kde] [--out benchmarks/results/ask_latency.md]
 
 --surrogate: general.surrogate of every planner (default kde, the paper's model, which the stored tables measure; the
 default portfolio at lab scale: benchmarks/lab_scale.py).

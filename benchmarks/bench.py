@@ -1,7 +1,7 @@
 """The paper's benchmark surfaces with the paper's protocol (one proposal per ask, the planner told each result),
 parallel over seeds and resumable (one JSON record per run in --out); one summary line per surface and strategy.
 
-    python benchmarks/bench.py --surface branin,slope [--strategy adam,genetic,gp,auto,random,deap] [--seeds 10]
+    python -m benchmarks.bench --surface branin,slope [--strategy adam,genetic,gp,auto,random,deap] [--seeds 10]
         [--budget N] [--variant ordinal|categorical] [--processes N] [--out bench-results] [--json FILE]
 
 Exit code 1 when any proposal violated a known constraint.
@@ -14,8 +14,8 @@ import json
 import sys
 from pathlib import Path
 
-from runner import STRATEGIES, Job, format_summary, run_jobs, summarize
-from surfaces import SURFACES
+from benchmarks.runner import STRATEGIES, Job, format_summary, run_jobs, summarize
+from benchmarks.surfaces import SURFACES
 
 
 def bench(args: argparse.Namespace) -> int:

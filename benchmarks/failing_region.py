@@ -3,7 +3,7 @@ domain (x0 > 0.5 and x1 > 0.5) where every experiment fails (reported as None); 
 experiments per run, the first ones the planner's random initialization; reports how many of experiments 31-60 went
 inside the region (uniform sampling: 25 %), per run and in all.
 
-    python benchmarks/failing_region.py [--seeds 5] [--feas-model kde|gp] [--surrogate kde|gp|auto|portfolio]
+    python -m benchmarks.failing_region [--seeds 5] [--feas-model kde|gp] [--surrogate kde|gp|auto|portfolio]
 """
 
 from __future__ import annotations

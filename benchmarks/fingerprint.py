@@ -1,8 +1,9 @@
 """Proposals of fixed seeds, as JSON: the check that a refactoring changed no behaviour (issue #36 asks for it).
 
-    .venv/bin/python benchmarks/fingerprint.py > after.json
+    .venv/bin/python -m benchmarks.fingerprint > after.json
     git worktree add /tmp/before <commit>
-    (cd /tmp/before && PYTHONPATH=/tmp/before <repo>/.venv/bin/python <repo>/benchmarks/fingerprint.py) > before.json
+    (cd /tmp/before && PYTHONPATH=/tmp/before/gryffin_ros:/tmp/before <repo>/.venv/bin/python \
+        <repo>/benchmarks/fingerprint.py) > before.json   # the package folder, or the root before the layout change
     cmp before.json after.json
 
 Five asks of two proposals each with seed 0, every proposal told a deterministic synthetic result, on the flow

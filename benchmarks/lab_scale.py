@@ -10,7 +10,7 @@
 - asks on issue #37's mixed Suzuki-like space (3 catalysts, 4 solvents with descriptors, 3 continuous conditions,
   T below the solvent's boiling point, Chimera yield then cost) at n = 5, 16, 50, 100 (median of 5 warm asks).
 
-    .venv/bin/python benchmarks/lab_scale.py [--surrogate NAME] [--repeats 3] [--cases warm,...,mixed]
+    .venv/bin/python -m benchmarks.lab_scale [--surrogate NAME] [--repeats 3] [--cases warm,...,mixed]
                                              [--out benchmarks/results/lab_scale.md]
 
 Observations are random feasible points with their objective values, told in one call; "warm" = the planner has

@@ -2,7 +2,7 @@
 one list message and as 1000 single messages, timed until all are stored; (b) 50 concurrent ~/json/recommend calls;
 (c) ~/json/get_status latency while the optimizer works.
 
-    python benchmarks/load.py [--out benchmarks/results/load.md]
+    python -m benchmarks.load [--out benchmarks/results/load.md]
 """
 
 from __future__ import annotations

@@ -9,31 +9,24 @@ Hickman, Aldeghi, Häse, Aspuru-Guzik, Digital Discovery 2022 (arXiv:2203.17241)
 options are the SMILES, objective `ered` minimized, without noise; a run ends when the best molecule is measured
 (random choice needs (57 + 1) / 2 = 29 experiments on average).
 
-    python benchmarks/molecules.py [--seeds 10] [--out benchmarks/results/molecules.md]
+    python -m benchmarks.molecules [--seeds 10] [--out benchmarks/results/molecules.md]
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
 import logging
 import statistics
 import time
 from pathlib import Path
 
+from benchmarks.btz_data import DATA, read_data
 from gryffin_ros.planner import Planner
 from gryffin_ros.planner.config import load_config
 from gryffin_ros.planner.molecules import MoleculeCache
 
-DATA = Path(__file__).resolve().parent / "data" / "btz_ered_57.csv"
 VARIANTS = {"RDKit default descriptors": "default", "no descriptors": "none"}
-
-
-def read_data(path: Path = DATA) -> tuple[dict[str, str], dict[str, float]]:
-    """name -> SMILES, name -> ered."""
-    with open(path, newline="") as handle:
-        rows = list(csv.DictReader(handle))
-    return {r["name"]: r["smiles"] for r in rows}, {r["name"]: float(r["ered"]) for r in rows}
+__all__ = ["DATA", "read_data", "experiments_to_best"]
 
 
 def experiments_to_best(smiles: dict[str, str], ered: dict[str, float], descriptors: str, seed: int,

@@ -1,10 +1,10 @@
-"""The paper's eight constrained benchmarks: our runs (from `python benchmarks/bench.py`) next to the published ones.
+"""The paper's eight constrained benchmarks: our runs (from `python -m benchmarks.bench`) next to the published ones.
 
-    python benchmarks/bench.py --surface branin,schwefel,dejong,discreteackley --strategy adam,genetic,random,deap \\
+    python -m benchmarks.bench --surface branin,schwefel,dejong,discreteackley --strategy adam,genetic,random,deap \\
         --seeds 100 --out bench-results
-    python benchmarks/bench.py --surface slope,sphere,michalewicz,camel --strategy adam,genetic,random,deap \\
+    python -m benchmarks.bench --surface slope,sphere,michalewicz,camel --strategy adam,genetic,random,deap \\
         --seeds 100 --out bench-results
-    python benchmarks/paper_benchmarks.py [--runs bench-results] [--data ../shared/data] [--out benchmarks/results]
+    python -m benchmarks.paper_benchmarks [--runs bench-results] [--data ../shared/data] [--out benchmarks/results]
 
 Published runs (../shared/data/gkc_benchmarks): continuous surfaces from the per-run traces, whose objective values are
 recomputed from the recorded points with our surface definitions (this sidesteps the sign-flipped Dragonfly values);
@@ -24,8 +24,9 @@ from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
-from runner import STRATEGIES, best_so_far, load_records, summarize
-from surfaces import CONTINUOUS_SURFACES, DISCRETE_SURFACES
+
+from benchmarks.runner import STRATEGIES, best_so_far, load_records, summarize
+from benchmarks.surfaces import CONTINUOUS_SURFACES, DISCRETE_SURFACES
 
 CONTINUOUS = ("branin", "schwefel", "dejong", "discreteackley")
 DISCRETE = ("slope", "sphere", "michalewicz", "camel")

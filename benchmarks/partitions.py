@@ -2,7 +2,7 @@
 of two instrument hosts; Linux network namespaces joined by a switch, `netlab.py`), with the lab network failing in
 the middle of it, measured from the outside: what the store holds, what the instruments' logs say they ran.
 
-    .venv/bin/python benchmarks/partitions.py [--budget 40] [--cuts 10,20,30] [--discovery static,subnet]
+    .venv/bin/python -m benchmarks.partitions [--budget 40] [--cuts 10,20,30] [--discovery static,subnet]
                                               [--flap-s 1,5] [--out benchmarks/results/partitions]
 
 Scenarios: an instrument host's link cut for each of `--cuts` seconds, the planner host's link cut for as long, and
@@ -33,11 +33,9 @@ import threading
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import netlab  # noqa: E402
-
-from gryffin_ros.nodes.supervisor import signals_as_interrupt  # noqa: E402
-from gryffin_ros.paths import share_path  # noqa: E402
+from benchmarks import netlab
+from gryffin_ros.nodes.supervisor import signals_as_interrupt
+from gryffin_ros.paths import share_path
 
 CONFIG = share_path("examples") / "flow_reactor.yaml"
 HANG_S = 600.0
@@ -177,7 +175,7 @@ def main(argv=None) -> int:
                 print(json.dumps(results[-1]), flush=True)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    command = ".venv/bin/python benchmarks/partitions.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    command = ".venv/bin/python -m benchmarks.partitions " + " ".join(argv if argv is not None else sys.argv[1:])
     out.with_suffix(".json").write_text(json.dumps({"command": command.strip(), "budget": args.budget,
                                                     "results": results}, indent=1) + "\n")
     setting = f"budget {args.budget}, batch 2, 0.5 s per experiment, two claiming instruments"

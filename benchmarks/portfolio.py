@@ -2,7 +2,7 @@
 families of `portfolio_tasks.py`, through the peer harness (`../shared/peers`: the same initial points per seed, one
 thread per run, ask time as process CPU), in one command and one table.
 
-    .venv/bin/python benchmarks/portfolio.py [--seeds 0-5] [--ours default,kde,gp] [--peers botorch,gpyopt]
+    .venv/bin/python -m benchmarks.portfolio [--seeds 0-5] [--ours default,kde,gp] [--peers botorch,gpyopt]
                                              [--tasks NAMES] [--out portfolio-results] [--lanes 2]
 
 Runs are stored by the harness under --out (one JSON per peer, task and seed) and skipped when present, so an
@@ -31,9 +31,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 PEERS_DIR = Path(os.environ.get("PEERS_DIR", ROOT.parent / "shared" / "peers"))
 VENVS = Path(os.environ.get("PEERVENVS", "/tmp/peervenvs"))
-sys.path[:0] = [str(PEERS_DIR), str(ROOT / "benchmarks")]
+sys.path.insert(0, str(PEERS_DIR))  # the harness's `problems`, which the task modules build on
 
-import portfolio_tasks  # noqa: E402
+from benchmarks import portfolio_tasks  # noqa: E402
 
 OURS = {"default": "gryffin_ros_default", "kde": "gryffin_ros_kde", "gp": "gryffin_ros_gp",
         "auto": "gryffin_ros_auto"}
@@ -47,18 +47,20 @@ def seeds_of(spec: str) -> list[int]:
     return out
 
 
-def job(peer: str, python: str, tasks: list[str], seeds: list[int], out: Path) -> str:
-    """One harness process: `peer` on `tasks` x `seeds`, skipping runs already stored."""
+def job(peer: str, python: str, tasks: list[str], seeds: list[int], out: Path, module: str = "portfolio_tasks"
+        ) -> str:
+    """One harness process: `peer` on `tasks` (of the task module `module`) x `seeds`, skipping runs already
+    stored."""
     todo = [(t, s) for t in tasks for s in seeds if not (out / t / f"{peer}_seed{s}.json").exists()]
     if not todo:
         return f"{peer}: nothing to do"
     env = dict(os.environ, OMP_NUM_THREADS="1", MKL_NUM_THREADS="1", ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
-               PEER_PATH=os.pathsep.join([str(ROOT / "benchmarks" / "peers"), str(ROOT / "benchmarks")]))
+               PEER_PATH=os.pathsep.join([str(ROOT / "benchmarks" / "peers"), str(ROOT / "benchmarks"), str(ROOT)]))
     done = []
     for task in sorted({t for t, _ in todo}):
         task_seeds = ":".join(str(s) for t, s in todo if t == task)
         result = subprocess.run([python, str(PEERS_DIR / "harness.py"), "--peer", peer, "--task-module",
-                                 "portfolio_tasks", "--tasks", task, "--seeds", f"{task}={task_seeds}", "--out",
+                                 module, "--tasks", task, "--seeds", f"{task}={task_seeds}", "--out",
                                  str(out)], cwd=PEERS_DIR, env=env, capture_output=True, text=True)
         if result.returncode:
             raise RuntimeError(f"{peer} on {task} failed:\n{result.stderr[-3000:]}")

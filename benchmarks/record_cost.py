@@ -3,7 +3,7 @@ node without and with `record`, alternating, on the flow-reactor config with the
 so that what the node does per message shows): Recommend round trip, observation -> `observation_accepted` event, and
 the planner process's CPU time per experiment (user + system, /proc); then the bag's size.
 
-    python benchmarks/record_cost.py [--calls 40] [--rounds 4] [--out benchmarks/results/record_cost.md]
+    python -m benchmarks.record_cost [--calls 40] [--rounds 4] [--out benchmarks/results/record_cost.md]
 """
 
 from __future__ import annotations
@@ -17,14 +17,13 @@ import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import rclpy  # noqa: E402
-import yaml  # noqa: E402
-from gryffin_ros_msgs.action import Recommend  # noqa: E402
-from ros_latency import NODES, Lab, stop, wait  # noqa: E402 - sets up the ROS environment before rclpy
+import rclpy
+import yaml
+from gryffin_ros_msgs.action import Recommend
 
-from gryffin_ros.nodes.supervisor import signals_as_interrupt  # noqa: E402
-from gryffin_ros.paths import share_path  # noqa: E402
+from benchmarks.ros_latency import NODES, Lab, stop, wait
+from gryffin_ros.nodes.supervisor import signals_as_interrupt
+from gryffin_ros.paths import share_path
 
 
 def cpu_seconds(pid: int) -> float:

@@ -13,7 +13,7 @@ synthesizable ones by
 
 One random first candidate per seed, the DFT values of the example without noise, up to 100 experiments.
 
-    python benchmarks/redox_simple_models.py [--seeds 40] [--out benchmarks/results/redox_simple_models.md]
+    python -m benchmarks.redox_simple_models [--seeds 40] [--out benchmarks/results/redox_simple_models.md]
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 node each, same config): recommend round trip, observation -> event; how long a cancel of a long Recommend goal
 takes to end it; the wall time of a 30-experiment closed-loop flow-reactor campaign (emulator experiment time 0).
 
-    python benchmarks/ros_latency.py [--calls 20] [--out benchmarks/results/ros_latency.md]
+    python -m benchmarks.ros_latency [--calls 20] [--out benchmarks/results/ros_latency.md]
 """
 
 from __future__ import annotations

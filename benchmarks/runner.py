@@ -23,8 +23,7 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-from surfaces import SURFACES, ContinuousSurface, DiscreteSurface
-
+from benchmarks.surfaces import SURFACES, ContinuousSurface, DiscreteSurface
 from gryffin_ros.planner import Genetic, GryffinRosError, Planner, Random
 from gryffin_ros.planner.strategies import BasePlanner
 

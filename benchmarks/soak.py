@@ -4,7 +4,7 @@ resident memory of the planner and emulator processes, ask time, observation -> 
 at the end the restart-to-ready time of the planner node on the full store, the export time and the best cost found
 over time.
 
-    .venv/bin/python benchmarks/soak.py [--budget 5000] [--batch 10] [--every 250] [--out benchmarks/results/soak]
+    .venv/bin/python -m benchmarks.soak [--budget 5000] [--batch 10] [--every 250] [--out benchmarks/results/soak]
 
 Ask time: from the node's `observation_accepted` event of the batch's last result to its `proposals_ready` event
 (both stamped by the node), so it is the ask as the node runs it. Acknowledgement: from this process receiving the
@@ -288,8 +288,9 @@ def main() -> None:
         rclpy.try_shutdown()
     args.out.parent.mkdir(parents=True, exist_ok=True)
     plot(ros_rows, api_rows, args.out.with_suffix(".png"))
-    text = (f"Soak: flow-reactor campaign (examples/flow_reactor.yaml, seed 0), {args.budget} experiments in batches "
-            f"of {args.batch}, 2 cores. Over ROS (planner node + flow_reactor emulator node, typed interfaces):\n\n"
+    text = (f"Soak: flow-reactor campaign (gryffin_ros/examples/flow_reactor.yaml, seed 0), {args.budget} experiments "
+            f"in batches of {args.batch}, 2 cores. Over ROS (planner node + flow_reactor emulator node, typed "
+            "interfaces):\n\n"
             + table(ros_rows, [("experiments", "experiments"), ("planner_mb", "planner RSS MB"),
                                ("emulator_mb", "emulator RSS MB"), ("ask_ms", "ask median ms"),
                                ("ask_max_ms", "ask max ms"), ("ack_ms", "obs -> ack median ms"),

@@ -1,8 +1,9 @@
-"""Stagnation: does a long flow-reactor campaign keep improving? The example config (examples/flow_reactor.yaml, the
-default surrogate) through the Python API, the BNN emulator measuring, several seeds; the cost of the best experiment
-(Chimera: X1 + X2 >= 0.9 first, then the cost) at each milestone, and how often the best changed after the first.
+"""Stagnation: does a long flow-reactor campaign keep improving? The example config
+(gryffin_ros/examples/flow_reactor.yaml, the default surrogate) through the Python API, the BNN emulator measuring,
+several seeds; the cost of the best experiment (Chimera: X1 + X2 >= 0.9 first, then the cost) at each milestone, and
+how often the best changed after the first.
 
-    .venv/bin/python benchmarks/stagnation.py [--seeds 0-3] [--budget 1000] [--batch 10] [--milestones 100,300,1000]
+    .venv/bin/python -m benchmarks.stagnation [--seeds 0-3] [--budget 1000] [--batch 10] [--milestones 100,300,1000]
                                               [--out benchmarks/results/stagnation]
 
 Each seed seeds both the planner and the emulator's noise. `--batch` proposals per ask (the soak's 10; the paper's
@@ -90,9 +91,10 @@ def main(argv=None) -> int:
         for seed in seeds_arg(args.seeds):
             results.append(run(seed, args.budget, args.batch, milestones, Path(tmp)))
             print(json.dumps(results[-1]), flush=True)
-    command = "  .venv/bin/python benchmarks/stagnation.py " + " ".join(sys.argv[1:] if argv is None else argv)
-    text = (f"Flow reactor (examples/flow_reactor.yaml, default surrogate), {args.budget} experiments in asks of "
-            f"{args.batch}, Python API; cost ($/min) of the best experiment by the Chimera hierarchy:\n\n{command}\n\n"
+    command = "  .venv/bin/python -m benchmarks.stagnation " + " ".join(sys.argv[1:] if argv is None else argv)
+    text = (f"Flow reactor (gryffin_ros/examples/flow_reactor.yaml, default surrogate), {args.budget} experiments "
+            f"in asks of {args.batch}, Python API; cost ($/min) of the best experiment by the Chimera hierarchy:"
+            f"\n\n{command}\n\n"
             + summary(results, milestones) + "\n")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.with_suffix(".md").write_text(text)

@@ -4,7 +4,7 @@ sum(x) <= s (a linear one, so hit-and-run chords are exact) of volume fraction 1
 from one experiment the chemist knows is feasible (the ball's centre; near the simplex's corner), then runs `--asks`
 ask/tell rounds on a quadratic objective with its minimum inside (off-centre in the ball; the simplex's centroid).
 
-    python benchmarks/tiny_regions.py [--dims 4 6] [--asks 8] [--out benchmarks/results]
+    python -m benchmarks.tiny_regions [--dims 4 6] [--asks 8] [--out benchmarks/results]
 
 "Rejection only" is the planner with the hit-and-run sampler switched off (its `walk` replaced, for this comparison
 only): start points are then uniform draws (at most general.max_rejection_draws per call) and ±5 % perturbations of
@@ -93,7 +93,7 @@ def main() -> None:
         rows.append(row)
         print(row, flush=True)
     lines = ["# Tiny feasible regions: seconds per recommendation vs feasible fraction", "",
-             f"Command: `python benchmarks/tiny_regions.py --asks {args.asks}` (one thread). A ball (radius r) or "
+             f"Command: `python -m benchmarks.tiny_regions --asks {args.asks}` (one thread). A ball (radius r) or "
              "corner simplex sum(x) <= r of the given volume fraction in [0, 1]^d, one known feasible experiment "
              "inside, then ask/tell rounds; 'best / r^2': best objective relative to r^2 (lower is better; the "
              "minimum is 0; the known experiment scores 0.25 in the ball, 0.076 (d = 4) / 0.061 (d = 6) in the "

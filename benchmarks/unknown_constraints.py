@@ -2,7 +2,7 @@
 NaN (a failed experiment) and counts toward the budget. Reports evaluations until the optimum is evaluated, with the
 1-d ordinal descriptor (discrete parameters) and without descriptors (categorical options).
 
-    python benchmarks/unknown_constraints.py [--seeds 100] [--processes 2] [--out benchmarks/results]
+    python -m benchmarks.unknown_constraints [--seeds 100] [--processes 2] [--out benchmarks/results]
                                              [--concrete-temperature C] [--surrogate kde|gp|auto|portfolio]
                                              [--feas-model kde|gp] [--variants ordinal naive]
                                              [--surfaces slope sphere michalewicz camel]
@@ -19,7 +19,7 @@ import statistics
 from multiprocessing import Pool
 from pathlib import Path
 
-from surfaces import DISCRETE_SURFACES, OPTIONS
+from benchmarks.surfaces import DISCRETE_SURFACES, OPTIONS
 
 # Atlas (GP with a feasibility classifier), best setting, recomputed from its raw results (issue text).
 ANCHOR = {"slope": 15.2, "sphere": 14.7, "michalewicz": 23.4, "camel": 48.6}

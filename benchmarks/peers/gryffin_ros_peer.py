@@ -3,8 +3,10 @@ surrogate: peer_gryffin_ros_default (no `surrogate` key: what a user gets), peer
 call `adapter(surrogate)`.
 
 Floats become continuous parameters, ints discrete ones (ordered options low..high), categorical parameters
-(`problems.CatParam`) categorical ones with their descriptors; the task's constraint is the planner's known
-constraint. Each proposal is reported back under its experiment_id, so nothing stays pending.
+(`problems.CatParam`) categorical ones with their descriptors; with `molecules` (peer_gryffin_ros_molecules), a
+categorical parameter that carries `smiles` (benchmarks/molecule_tasks.py) has its options given as SMILES, and RDKit
+computes their default descriptors. The task's constraint is the planner's known constraint. Each proposal is
+reported back under its experiment_id, so nothing stays pending.
 """
 
 from __future__ import annotations
@@ -15,13 +17,23 @@ from gryffin_ros.planner import Planner
 DEFAULT_SEEDS = {"branin": range(10), "slope": range(10), "reactor": range(3)}
 
 
-def config(task, surrogate: str | None) -> dict:
+def option_names(p, seed: int) -> list[str]:
+    """The names of a categorical parameter's options in the run of `seed` (a molecule task's labels)."""
+    return p.labels(seed) if hasattr(p, "labels") else list(p.options)
+
+
+def config(task, surrogate: str | None, molecules: bool = False, seed: int = 0) -> dict:
     parameters = []
     for p in task.params:
-        if getattr(p, "categorical", False):
-            parameter = {"name": p.name, "type": "categorical", "options": list(p.options)}
+        if molecules and getattr(p, "smiles", None):
+            parameters.append({"name": p.name, "type": "categorical",
+                               "options": dict(zip(option_names(p, seed), p.smiles)),
+                               "molecular_descriptors": "default"})
+        elif getattr(p, "categorical", False):
+            names = option_names(p, seed)
+            parameter = {"name": p.name, "type": "categorical", "options": names}
             if any(p.descriptors):
-                parameter["descriptors"] = dict(zip(p.options, p.descriptors))
+                parameter["descriptors"] = dict(zip(names, p.descriptors))
             parameters.append(parameter)
         elif p.kind == "int":
             parameters.append({"name": p.name, "type": "discrete", "options": list(range(p.low, p.high + 1))})
@@ -31,24 +43,26 @@ def config(task, surrogate: str | None) -> dict:
             "general": {"surrogate": surrogate} if surrogate else {}}
 
 
-def to_planner(task, x: list) -> dict:
+def to_planner(task, x: list, seed: int = 0) -> dict:
     """A harness point (categorical options as indices) -> the planner's parameters."""
-    return {p.name: (p.options[int(v)] if getattr(p, "categorical", False) else v) for p, v in zip(task.params, x)}
+    return {p.name: (option_names(p, seed)[int(v)] if getattr(p, "categorical", False) else v)
+            for p, v in zip(task.params, x)}
 
 
-def from_planner(task, params: dict) -> list:
-    return [(p.options.index(params[p.name]) if getattr(p, "categorical", False) else params[p.name])
+def from_planner(task, params: dict, seed: int = 0) -> list:
+    return [(option_names(p, seed).index(params[p.name]) if getattr(p, "categorical", False) else params[p.name])
             for p in task.params]
 
 
 class Adapter:
     surrogate = "kde"
+    molecules = False
 
     def __init__(self, task, seed):
         self.names = [p.name for p in task.params]
-        self.task = task
-        self.planner = Planner(config(task, self.surrogate),
-                               known_constraints=lambda params: task.feasible(from_planner(task, params)),
+        self.task, self.seed = task, seed
+        self.planner = Planner(config(task, self.surrogate, self.molecules, seed),
+                               known_constraints=lambda params: task.feasible(from_planner(task, params, seed)),
                                seed=seed)
         self.asked: str | None = None  # experiment_id of the proposal the harness is evaluating
         self.choices: dict[str, int] = {}
@@ -58,14 +72,14 @@ class Adapter:
         self.asked = proposal.experiment_id
         surrogate = proposal.meta.get("surrogate", "random")
         self.choices[surrogate] = self.choices.get(surrogate, 0) + 1
-        return from_planner(self.task, proposal.params)
+        return from_planner(self.task, proposal.params, self.seed)
 
     def tell(self, xs, ys) -> None:
         for x, y in zip(xs, ys):
             if y is None:  # a violation (the harness counts it); not an observation of the objective
                 continue
             experiment_id = self.asked if len(xs) == 1 else None
-            self.planner.tell({"experiment_id": experiment_id, "params": to_planner(self.task, x),
+            self.planner.tell({"experiment_id": experiment_id, "params": to_planner(self.task, x, self.seed),
                                "objectives": {"y": float(y)}})
         self.asked = None
 
@@ -73,8 +87,9 @@ class Adapter:
         return {f"chose_{name}": count for name, count in self.choices.items()}
 
 
-def adapter(surrogate: str | None) -> tuple[str, str, dict, type]:
-    """(PEER, VERSION, DEFAULT_SEEDS, Optimizer) for the harness; surrogate None: the planner's default."""
-    name = surrogate or "default"
-    optimizer = type(f"Optimizer_{name}", (Adapter,), {"surrogate": surrogate})
+def adapter(surrogate: str | None, molecules: bool = False) -> tuple[str, str, dict, type]:
+    """(PEER, VERSION, DEFAULT_SEEDS, Optimizer) for the harness; surrogate None: the planner's default; molecules:
+    SMILES options with RDKit's default descriptors where the task has them."""
+    name = "molecules" if molecules else surrogate or "default"
+    optimizer = type(f"Optimizer_{name}", (Adapter,), {"surrogate": surrogate, "molecules": molecules})
     return f"gryffin_ros_{name}", gryffin_ros.__version__, DEFAULT_SEEDS, optimizer

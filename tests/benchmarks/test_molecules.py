@@ -3,8 +3,8 @@
 import csv
 
 import pytest
-from molecules import DATA, experiments_to_best, read_data
 
+from benchmarks.molecules import DATA, experiments_to_best, read_data
 from gryffin_ros.planner.molecules import MoleculeCache
 
 

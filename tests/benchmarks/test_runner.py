@@ -3,10 +3,11 @@
 import json
 
 import pytest
-import runner
-from bench import main
-from runner import Job, best_so_far, run_job, run_jobs, summarize
-from surfaces import SURFACES
+
+from benchmarks import runner
+from benchmarks.bench import main
+from benchmarks.runner import Job, best_so_far, run_job, run_jobs, summarize
+from benchmarks.surfaces import SURFACES
 
 
 def test_discrete_run_stops_at_the_optimum_without_violations():

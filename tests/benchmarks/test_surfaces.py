@@ -3,8 +3,8 @@ prints them, and the vectorized constraint agreeing with the point-wise one."""
 
 import numpy as np
 import pytest
-from surfaces import CAMEL_INFEASIBLE, CONTINUOUS_SURFACES, DISCRETE_SURFACES, SURFACES
 
+from benchmarks.surfaces import CAMEL_INFEASIBLE, CONTINUOUS_SURFACES, DISCRETE_SURFACES, SURFACES
 from gryffin_ros.planner import KnownConstraints, SearchSpace
 
 

@@ -6,9 +6,9 @@ import os
 import threading
 import time
 
-import netlab
 import pytest
 
+from benchmarks import netlab
 from gryffin_ros.paths import share_path
 
 REASON = netlab.unavailable()

@@ -1,0 +1,5 @@
+"""Peer harness adapter: BayBE on molecular tasks, encoding one-hot (the options alone) (see baybe_molecules.py)."""
+
+from baybe_molecules import adapter
+
+PEER, VERSION, DEFAULT_SEEDS, Optimizer = adapter(None)
