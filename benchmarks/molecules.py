@@ -20,13 +20,12 @@ import statistics
 import time
 from pathlib import Path
 
-from benchmarks.btz_data import DATA, read_data
+from benchmarks.btz_data import read_data
 from gryffin_ros.planner import Planner
 from gryffin_ros.planner.config import load_config
 from gryffin_ros.planner.molecules import MoleculeCache
 
 VARIANTS = {"RDKit default descriptors": "default", "no descriptors": "none"}
-__all__ = ["DATA", "read_data", "experiments_to_best"]
 
 
 def experiments_to_best(smiles: dict[str, str], ered: dict[str, float], descriptors: str, seed: int,

@@ -4,7 +4,8 @@ import csv
 
 import pytest
 
-from benchmarks.molecules import DATA, experiments_to_best, read_data
+from benchmarks.btz_data import DATA, read_data
+from benchmarks.molecules import experiments_to_best
 from gryffin_ros.planner.molecules import MoleculeCache
 
 
