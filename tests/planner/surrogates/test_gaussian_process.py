@@ -243,6 +243,21 @@ def test_a_fit_that_explains_the_data_as_noise_is_repeated_from_short_length_sca
     assert fitted.log_likelihood() > first.log_likelihood() + 0.5
 
 
+def test_a_noisy_fit_with_some_signal_is_kept_as_it_is(monkeypatch):
+    """Noisy results (a sine in x0 under noise of its own size): the fit's signal is about half its noise, which is a
+    model, not a collapse (the flow reactor's noisy fits are like it, and repeating them left campaigns on a poor
+    cost): no second fit is made."""
+    space = Planner(config3()).space
+    rng = np.random.default_rng(4)
+    X = rng.uniform(0.0, 1.0, (30, 3))
+    y = np.sin(4 * X[:, 0]) + rng.normal(0.0, 1.0, 30)
+    repeated = []
+    monkeypatch.setattr(gp_module, "short_start", lambda model: repeated.append(model))
+    fitted = GaussianProcess(space, X, y, seed=0)
+    assert gp_module.MIN_SIGNAL_TO_NOISE < fitted.signal_to_noise() < 1.0
+    assert repeated == []
+
+
 def test_on_a_plateau_with_one_good_combination_the_campaign_tries_others():
     """Mostly near-zero results and one good one in combination a: the planner does not stay on a, proposals are
     feasible, and the same seed and data give the same proposals."""
