@@ -17,23 +17,18 @@ from gryffin_ros.planner import Planner
 DEFAULT_SEEDS = {"branin": range(10), "slope": range(10), "reactor": range(3)}
 
 
-def option_names(p, seed: int) -> list[str]:
-    """The names of a categorical parameter's options in the run of `seed` (a molecule task's labels)."""
-    return p.labels(seed) if hasattr(p, "labels") else list(p.options)
-
-
-def config(task, surrogate: str | None, molecules: bool = False, seed: int = 0) -> dict:
+def config(task, surrogate: str | None, molecules: bool, names: dict[str, list[str]]) -> dict:
+    """The planner's config of a harness task; `names`: option_names_of."""
     parameters = []
     for p in task.params:
         if molecules and getattr(p, "smiles", None):
             parameters.append({"name": p.name, "type": "categorical",
-                               "options": dict(zip(option_names(p, seed), p.smiles)),
+                               "options": dict(zip(names[p.name], p.smiles)),
                                "molecular_descriptors": "default"})
         elif getattr(p, "categorical", False):
-            names = option_names(p, seed)
-            parameter = {"name": p.name, "type": "categorical", "options": names}
+            parameter = {"name": p.name, "type": "categorical", "options": names[p.name]}
             if any(p.descriptors):
-                parameter["descriptors"] = dict(zip(names, p.descriptors))
+                parameter["descriptors"] = dict(zip(names[p.name], p.descriptors))
             parameters.append(parameter)
         elif p.kind == "int":
             parameters.append({"name": p.name, "type": "discrete", "options": list(range(p.low, p.high + 1))})
@@ -43,15 +38,21 @@ def config(task, surrogate: str | None, molecules: bool = False, seed: int = 0) 
             "general": {"surrogate": surrogate} if surrogate else {}}
 
 
-def to_planner(task, x: list, seed: int = 0) -> dict:
-    """A harness point (categorical options as indices) -> the planner's parameters."""
-    return {p.name: (option_names(p, seed)[int(v)] if getattr(p, "categorical", False) else v)
-            for p, v in zip(task.params, x)}
+def option_names_of(task, seed: int) -> dict[str, list[str]]:
+    """Each categorical parameter's option names in the run of `seed` (a molecule task's labels, else its options),
+    by parameter name; made once per run: the known-constraint callable converts every point the planner checks."""
+    return {p.name: p.labels(seed) if hasattr(p, "labels") else list(p.options) for p in task.params
+            if getattr(p, "categorical", False)}
 
 
-def from_planner(task, params: dict, seed: int = 0) -> list:
-    return [(option_names(p, seed).index(params[p.name]) if getattr(p, "categorical", False) else params[p.name])
-            for p in task.params]
+def to_planner(task, x: list, names: dict[str, list[str]]) -> dict:
+    """A harness point (categorical options as indices) -> the planner's parameters; `names`: option_names_of."""
+    return {p.name: (names[p.name][int(v)] if p.name in names else v) for p, v in zip(task.params, x)}
+
+
+def from_planner(task, params: dict, index: dict[str, dict[str, int]]) -> list:
+    """The planner's parameters -> a harness point; `index`: option name -> its index, by parameter name."""
+    return [(index[p.name][params[p.name]] if p.name in index else params[p.name]) for p in task.params]
 
 
 class Adapter:
@@ -60,9 +61,12 @@ class Adapter:
 
     def __init__(self, task, seed):
         self.names = [p.name for p in task.params]
-        self.task, self.seed = task, seed
-        self.planner = Planner(config(task, self.surrogate, self.molecules, seed),
-                               known_constraints=lambda params: task.feasible(from_planner(task, params, seed)),
+        self.task = task
+        self.option_names = option_names_of(task, seed)
+        self.option_index = {name: {o: i for i, o in enumerate(options)} for name, options in self.option_names.items()}
+        self.planner = Planner(config(task, self.surrogate, self.molecules, self.option_names),
+                               known_constraints=lambda params: task.feasible(from_planner(task, params,
+                                                                                           self.option_index)),
                                seed=seed)
         self.asked: str | None = None  # experiment_id of the proposal the harness is evaluating
         self.choices: dict[str, int] = {}
@@ -72,14 +76,14 @@ class Adapter:
         self.asked = proposal.experiment_id
         surrogate = proposal.meta.get("surrogate", "random")
         self.choices[surrogate] = self.choices.get(surrogate, 0) + 1
-        return from_planner(self.task, proposal.params, self.seed)
+        return from_planner(self.task, proposal.params, self.option_index)
 
     def tell(self, xs, ys) -> None:
         for x, y in zip(xs, ys):
             if y is None:  # a violation (the harness counts it); not an observation of the objective
                 continue
             experiment_id = self.asked if len(xs) == 1 else None
-            self.planner.tell({"experiment_id": experiment_id, "params": to_planner(self.task, x, self.seed),
+            self.planner.tell({"experiment_id": experiment_id, "params": to_planner(self.task, x, self.option_names),
                                "objectives": {"y": float(y)}})
         self.asked = None
 
