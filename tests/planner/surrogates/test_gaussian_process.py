@@ -228,47 +228,6 @@ def run_two(planner, n):
         made.append(proposal)
     return made[1:]
 
-
-@pytest.mark.parametrize("setting, n, since_best, expected", [
-    ("portfolio", 1, 9, 0), ("portfolio", 1, 10, 1), ("portfolio", 1, 11, 0), ("portfolio", 1, 20, 1),
-    ("auto", 1, 30, 1), ("portfolio", 3, 8, 1), ("portfolio", 10, 10, 1), ("portfolio", 25, 10, 3),
-    ("portfolio", 5, 3, 0), ("portfolio", 10, 3, 1), ("gp", 1, 10, 0), ("kde", 1, 10, 0)])
-def test_a_stalled_campaign_explores_one_proposal_in_every_ten(setting, n, since_best, expected):
-    """After STALL_EXPERIMENTS experiments without a better result, one proposal in every STALL_EXPERIMENTS comes
-    from the kernel density's most exploring strategy; `gp` and `kde` are left as the user chose them. The i-th
-    proposal of a batch follows since_best + i experiments without a better result: a batch of 3 after 8 has one
-    proposal that follows 10."""
-    from gryffin_ros.planner.surrogates.choice import STALL_EXPERIMENTS
-    assert STALL_EXPERIMENTS == 10  # the table above counts in tens
-    planner = Planner(config3(surrogate=setting), seed=0)
-    assert planner.surrogate_choice.exploring(n, since_best) == expected
-
-
-def test_a_stalled_gp_campaign_hands_one_proposal_to_the_exploring_kernel_density():
-    """The best result is the first; ten worse ones follow. The GP still models the data (a bowl), but the next
-    proposal comes from the kernel density's most exploring strategy, says so, and satisfies the constraint; with
-    one better result the GP proposes again. Same seed and data, same proposal."""
-    config = {**config3(num_random_samples=50), "constraints": ["x0 + x1 <= 1.2"]}
-    def campaign():
-        planner = Planner(config, seed=5)
-        for x in [(0.3, 0.6, 0.5), *np.random.default_rng(3).uniform(0.0, 0.6, (10, 3))]:
-            params = {f"x{i}": float(v) for i, v in enumerate(x)}
-            planner.tell({**params, "y": bowl3(params)})
-        return planner
-    first, again = campaign(), campaign()
-    (proposal,) = first.ask()
-    assert proposal.meta["surrogate"] == "kde" and proposal.strategy == -1.0
-    assert "no better result in the last 10 experiments: 1 of 1 from the kernel density's most exploring " \
-        "strategy" in proposal.meta["surrogate_reason"]
-    assert "GP first" in proposal.meta["surrogate_reason"]
-    assert proposal.params["x0"] + proposal.params["x1"] <= 1.2
-    (repeated,) = again.ask()
-    assert repeated.params == proposal.params
-    first.tell({**proposal.params, "y": bowl3(proposal.params)})
-    first.tell({"x0": 0.3, "x1": 0.6, "x2": 0.5, "y": -1.0})  # a better result
-    assert first.ask()[0].meta["surrogate"] == "gp"
-
-
 COUPLING = {"parameters": [{"name": "c", "type": "categorical", "options": ["a", "b", "c", "d"],
                             "descriptors": {"a": [0.0, 0.2], "b": [0.4, 1.0], "c": [1.0, 0.1], "d": [0.6, 0.5]}}]
             + [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(3)],

@@ -225,35 +225,16 @@ class Planner(BasePlanner):
         meta.update(feasibility.notes if feasibility is not None else {})
         report("optimizing", 0.0)
         start, exhaustive = self.start_points(rng, X[int(np.argmin(merits))], X)
-        if gp is None:
-            return (*self._propose_kde(n, rng, density, start, exhaustive, feasibility, observed, chosen), meta)
-        exploring = self.surrogate_choice.exploring(n, self._since_best(merits))
-        points, strategies = np.empty((0, self.space.dim)), []
-        if n > exploring:
-            points = self._propose_gp(n - exploring, rng, gp, start, exhaustive, feasibility, observed, chosen)
-            strategies = [None] * len(points)
-        if exploring:
-            meta["surrogate_reason"] += (f"; no better result in the last {self._since_best(merits)} experiments: "
-                                         f"{exploring} of {n} from the kernel density's most exploring strategy")
-            if exploring == n:
-                meta["surrogate"] = "kde"
-            more, more_strategies = self._propose_kde(exploring, rng, density, start, exhaustive, feasibility,
-                                                      observed, np.concatenate([chosen, points]),
-                                                      values=self.strategy_values().min(keepdims=True))
-            points, strategies = np.concatenate([points, more]), strategies + more_strategies
-        return points, strategies, meta
-
-    def _since_best(self, merits: np.ndarray) -> int:
-        """Experiments (successful or failed) after the best one, `merits` those of the successful ones in order."""
-        successful = [i for i, o in enumerate(self.observations) if not o.failed]
-        return len(self.observations) - 1 - successful[int(np.argmin(merits))]
+        if gp is not None:
+            return self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen), [None] * n, meta
+        return (*self._propose_kde(n, rng, density, start, exhaustive, feasibility, observed, chosen), meta)
 
     def _propose_kde(self, n: int, rng: np.random.Generator, density: KernelDensity, start: np.ndarray,
-                     exhaustive: bool, feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray,
-                     values: np.ndarray | None = None) -> tuple[np.ndarray, list[float | None]]:
-        """n points by the kernel density's acquisition, the sampling strategies (`values`, else the configured
-        ones) taken in turn across the campaign, spread out by the diversity-aware selection."""
-        values = self.strategy_values() if values is None else values
+                     exhaustive: bool, feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray
+                     ) -> tuple[np.ndarray, list[float | None]]:
+        """n points by the kernel density's acquisition, the sampling strategies taken in turn across the campaign,
+        spread out by the diversity-aware selection."""
+        values = self.strategy_values()
         optimizer = self.optimizer()
         refined: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         points, strategies = [], []

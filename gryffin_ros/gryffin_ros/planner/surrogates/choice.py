@@ -26,20 +26,14 @@ AUTO_MIN_OBSERVATIONS = 5
 # `portfolio` starts from the GP when the space has at least this many continuous parameters, from the kernel density
 # otherwise. Measured (benchmarks/README.md, "Problem portfolio" and "Surrogates on the paper's surfaces"): the GP
 # alone needs 4-5x more evaluations on the paper's 2-D plateau and rugged surfaces (Sphere, Michalewicz), where the
-# kernel density first and the comparison keep the best of both; with 3+ continuous dims (the flow reactor, the
+# kernel density first and the comparison keep the best of both; with 3+ continuous dims (the
 # kinetics and smooth 6-D/10-D problems) the GP wins, and beyond 4 the kernel density keeps Gryffin's narrow kernels
 # and is close to random search. With several objectives the portfolio keeps the kernel density: Chimera's merit
 # steps at each tolerance, and a GP ranks such data well (so it takes over) but its expected improvement climbs the
 # smoothed step slowly. Measured on the flow reactor (3 continuous, seeds 0-19, benchmarks/README.md "Applications"):
-# GP first 0.0042 $/min, kernel density first with the GP taking over 0.0031 (seeds at 0.0065 and 0.0096 where it had),
-# kernel density alone 0.0028 (worst 0.0037); on the redox candidates the GP did worse too.
+# GP first 0.0042 $/min, kernel density first with the GP taking over 0.0031 (seeds at 0.0065 and 0.0096 where it had;
+# a trial tree), kernel density alone 0.0028 (worst 0.0037); on the redox candidates the GP did worse too.
 PORTFOLIO_GP_MIN_CONTINUOUS = 3
-# `auto`/`portfolio` with the GP as their model: once STALL_EXPERIMENTS experiments in a row have not improved on the
-# best, one proposal in every STALL_EXPERIMENTS comes from the kernel density's most exploring strategy until one does.
-# The GP's expected improvement can settle on a local optimum it believes it understands: the flow reactor's noisy
-# fits held 2 of 20 campaigns on a ratio boundary at 0.016-0.018 $/min while the cheapest conditions lie on the other
-# one (benchmarks/README.md, "Stuck campaigns"); Gryffin's exploring strategy looks where the data are sparse.
-STALL_EXPERIMENTS = 10
 
 
 class FitCache:
@@ -120,15 +114,6 @@ class SurrogateChoice:
         gp.conditioned = kept
         self.fits.put(key, gp.hyperparameters)
         return gp
-
-    def exploring(self, n: int, since_best: int) -> int:
-        """How many of an ask's n proposals the kernel density's most exploring strategy makes, `since_best` the
-        number of experiments after the best one: the i-th proposal (i = 0..n-1) follows since_best + i experiments
-        without a better result, and one is made for each multiple of STALL_EXPERIMENTS among those counts."""
-        last = since_best + n - 1
-        if self.setting not in ("auto", "portfolio") or last < STALL_EXPERIMENTS:
-            return 0
-        return last // STALL_EXPERIMENTS - (max(since_best, STALL_EXPERIMENTS) - 1) // STALL_EXPERIMENTS
 
     def prior(self) -> str:
         """The model of `auto`/`portfolio` until the data clearly favour the other one."""
