@@ -54,6 +54,27 @@ def test_features_map_every_kind_of_parameter_into_the_unit_cube():
     np.testing.assert_allclose(*features.of(ends).numpy(), atol=1e-12)
 
 
+
+def test_descriptor_columns_of_categorical_parameters_keep_a_length_scale_floor():
+    """The kernel's length scales may shrink to 1e-3 on continuous and ordinal inputs, but not below
+    DESCRIPTOR_LENGTHSCALE_MIN on a categorical parameter's descriptor columns, even when the data pull them there:
+    results that differ only between options 'a' and 'b', whose descriptors are close (0.05 apart), with the
+    continuous input irrelevant."""
+    space = SearchSpace.from_config([
+        {"name": "t", "type": "continuous", "low": 0, "high": 1},
+        {"name": "n", "type": "discrete", "options": [1, 2, 4, 8]},
+        {"name": "solvent", "type": "categorical", "options": ["a", "b", "c"],
+         "descriptors": {"a": [0.0], "b": [0.05], "c": [1.0]}}])
+    floor = gp_module.DESCRIPTOR_LENGTHSCALE_MIN
+    assert Features(space).lengthscale_floors.tolist() == [1e-3, 1e-3, floor]
+    rng = np.random.default_rng(0)
+    params = [{"t": float(rng.random()), "n": [1, 2, 4, 8][i % 4], "solvent": "ab"[i % 2]} for i in range(16)]
+    y = np.array([1.0 if p["solvent"] == "a" else -1.0 for p in params])
+    gp = GaussianProcess(space, space.to_internal(params), y, seed=0)
+    lengthscale = gp.model.covar_module.base_kernel.lengthscale.detach().numpy().ravel()
+    assert lengthscale[2] >= floor * (1 - 1e-9)
+    assert lengthscale[2] < 2 * floor  # the data push it down to the floor: a floor that holds, not an idle one
+
 def test_rank_correlation():
     a = np.array([1.0, 2.0, 3.0, 4.0])
     assert rank_correlation(a, a ** 3) == pytest.approx(1.0)

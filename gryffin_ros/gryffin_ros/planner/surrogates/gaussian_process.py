@@ -29,6 +29,14 @@ MIN_NOISE = 1e-6
 # Kernel length scales (inputs in [0, 1]) and output scale (outputs standardized) are fitted within these bounds.
 LENGTHSCALE_BOUNDS = (1e-3, 20.0)
 OUTPUTSCALE_BOUNDS = (1e-3, 100.0)
+# ... except on the descriptor columns of categorical parameters (each scaled to [0, 1]), whose length scales stay at
+# or above DESCRIPTOR_LENGTHSCALE_MIN: far below the spacing of the options, every option (and every combination of
+# options) is its own unrelated function and the descriptors tell the GP nothing. m_coupling's fits (3 categorical
+# parameters with descriptors, 3 continuous) ended at 0.001-0.02 there, and their expected improvement beside the
+# first good combination always beat that of the untried ones (seed 8 stayed on its first one for 30 experiments,
+# normalized regret 0.55; benchmarks/README.md "Stuck campaigns on mixed spaces"). At 0.2, options a quarter of the
+# range apart still correlate at ~0.4 (Matern-5/2).
+DESCRIPTOR_LENGTHSCALE_MIN = 0.2
 # Largest number of candidates in one posterior evaluation.
 CHUNK = 4096
 # Hyperparameters are fitted to at most FIT_MAX observations (each marginal-likelihood evaluation costs n^3: a fit took
@@ -100,6 +108,13 @@ class Features:
         offsets = np.cumsum([0] + parts)
         self.dim = int(offsets[-1])
         self.cat_dims = [int(offsets[i]) for i, (kind, _, _) in enumerate(self.columns) if kind == "category"]
+        # the least length scale of each input that a Matern kernel sees (all but the categorical ones), in order
+        floors = []
+        for (kind, j, _), width in zip(self.columns, parts):
+            if kind != "category":
+                described = kind == "table" and space.parameters[int(space.finite_idx[j])].kind == "categorical"
+                floors += [DESCRIPTOR_LENGTHSCALE_MIN if described else LENGTHSCALE_BOUNDS[0]] * width
+        self.lengthscale_floors = torch.as_tensor(floors, dtype=DTYPE)
 
     def __call__(self, xc: torch.Tensor, xf: torch.Tensor) -> torch.Tensor:
         """xc: (M, C) continuous coordinates (may require grad), xf: (M, F) long option indices -> (M, G)."""
@@ -168,7 +183,8 @@ class GaussianProcess:
         likelihood.noise_covar.register_constraint("raw_noise", GreaterThan(MIN_NOISE))
         # ARD Matern-5/2 without hyperpriors: the marginal likelihood alone, as in GPyOpt, within bounds that keep a
         # smooth trend (a quadratic bowl, a slope) from pushing length and output scales to infinity
-        matern = partial(MaternKernel, nu=2.5, lengthscale_constraint=Interval(*LENGTHSCALE_BOUNDS))
+        matern = partial(MaternKernel, nu=2.5, lengthscale_constraint=Interval(
+            self.features.lengthscale_floors, torch.full_like(self.features.lengthscale_floors, LENGTHSCALE_BOUNDS[1])))
         if self.features.cat_dims:
             self.model = MixedSingleTaskGP(train_X, train_Y, cat_dims=self.features.cat_dims, likelihood=likelihood,
                                            cont_kernel_factory=matern, outcome_transform=Standardize(m=1))
