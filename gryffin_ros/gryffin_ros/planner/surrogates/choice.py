@@ -117,8 +117,7 @@ class SurrogateChoice:
 
     def prior(self) -> str:
         """The model of `auto`/`portfolio` until the data clearly favour the other one."""
-        if (self.setting == "portfolio" and self.objectives == 1
-                and len(self.space.cont_idx) >= PORTFOLIO_GP_MIN_CONTINUOUS):
+        if self.setting == "portfolio" and len(self.space.cont_idx) >= PORTFOLIO_GP_MIN_CONTINUOUS:
             return "gp"
         return "kde"
 
