@@ -56,8 +56,12 @@ class AskQueue:
 
     def settled(self) -> bool:
         """No ask is queued or running."""
+        return not self.in_progress()
+
+    def in_progress(self) -> int:
+        """How many asks are queued or running."""
         with self._lock:
-            return not self._running
+            return len(self._running)
 
     def shutdown(self) -> None:
         self.close("the planner is shutting down")

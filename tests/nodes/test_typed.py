@@ -40,15 +40,37 @@ EXAMPLES = share_path("examples")
 RESEND_S = 5.0
 # an accepted goal whose result has not come this long after is sent again too (an ask takes about a second there)
 RESULT_RESEND_S = 30.0
-# a campaign whose recommendation of many points takes far longer than a cancel needs to arrive (the genetic
-# optimizer over six continuous parameters, 400 points of a batch, each re-scored)
-LONG_CONFIG = {
-    "name": "long_test",
-    "parameters": [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(6)],
-    "objectives": [{"name": "y", "goal": "min"}],
-    "constraints": ["x0 + x1 < 1.5"],
-    "general": {"acquisition_optimizer": "genetic", "surrogate": "kde"},
-}
+
+
+class Gate:
+    """A campaign whose recommendations can be held in the middle of their optimization: its `test_gate` constraint
+    plugin (tests/plugin_package) waits while the file `hold` exists. A cancel or a stop then always arrives while the
+    recommendation runs, however fast the machine (a long ask only made that likely: a fast CI machine finished one
+    of 400 points before the cancel came)."""
+
+    def __init__(self, tmp_path: Path) -> None:
+        self.hold = tmp_path / "hold"
+        self.held = tmp_path / "hold.held"
+        self.config = {
+            "name": "held_test",
+            "parameters": [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(3)],
+            "objectives": [{"name": "y", "goal": "min"}],
+            "constraints": ["x0 + x1 < 1.5", {"plugin": "test_gate", "options": {"hold": str(self.hold)}}],
+            "general": {"surrogate": "kde"},
+        }
+
+    def held_goal(self, lab: TypedLab, feedback: list | None = None):
+        """A Recommend goal, accepted and held at the gate."""
+        self.held.unlink(missing_ok=True)
+        self.hold.touch()
+        goal = lab.send_goal(3, feedback)
+        assert goal.accepted
+        wait_until(self.held.exists, "the recommendation held at the gate")
+        return goal
+
+    def release(self) -> None:
+        self.hold.unlink()
+
 
 
 def wait_until(condition, what: str, timeout: float = HANG_S, fail: bool = True):
@@ -222,50 +244,60 @@ def test_a_managed_node_is_configured_and_activated_then_recommends_and_learns(l
     assert lab.state() == "unconfigured"
 
 
-def long_goal_optimizing(lab: TypedLab, feedback: list, learn_first: bool = True):
-    """A Recommend goal of 400 proposals on LONG_CONFIG, once the optimizer reports that it is running; with
-    `learn_first`, two results are reported before it, so that a model exists and the ask takes long."""
-    if learn_first:
-        first = lab.recommend_now(2).result.proposals
-        lab.wait_matched()
-        for i, proposal in enumerate(first):
-            lab.observations.publish(observation_of(proposal, {"y": float(i)}))
-        lab.observation_events(2)
-    goal = lab.send_goal(400, feedback)
-    assert goal.accepted
-    wait_until(lambda: any(f.feedback.stage in ("optimizing", "selecting") for f in list(feedback)),
-               "feedback from the optimizer")
-    return goal
+def learn_two_results(lab: TypedLab) -> None:
+    """Two results reported, so that the next recommendation builds a model and optimizes it."""
+    first = lab.recommend_now(2).result.proposals
+    lab.wait_matched()
+    for i, proposal in enumerate(first):
+        lab.observations.publish(observation_of(proposal, {"y": float(i)}))
+    lab.observation_events(2)
 
 
-def test_a_long_recommendation_is_canceled_and_leaves_nothing_pending(lab, start_planner):
-    start_planner(LONG_CONFIG, auto_propose=False)
+def stopping_logged(planner) -> bool:
+    return "recommendation(s) in progress" in planner.output()
+
+
+def test_a_running_recommendation_is_canceled_and_leaves_nothing_pending(lab, start_planner, tmp_path):
+    gate = Gate(tmp_path)
+    planner = start_planner(gate.config, auto_propose=False)
+    learn_two_results(lab)
     feedback: list = []
-    goal = long_goal_optimizing(lab, feedback)
-    lab.wait(goal.cancel_goal_async(), "the cancel response")
+    goal = gate.held_goal(lab, feedback)
+    answer = lab.wait(goal.cancel_goal_async(), "the cancel response")
+    assert answer.return_code == 0 and len(answer.goals_canceling) == 1  # CancelGoal ERROR_NONE: taken
+    gate.release()
     outcome = lab.wait(goal.get_result_async(), "the canceled result")
     assert outcome.status == 5, outcome  # GoalStatus.STATUS_CANCELED
     assert not outcome.result.proposals and "canceled" in outcome.result.error
+    assert outcome.result.n_observations == 2
     status = lab.status()
     assert (status.n_pending, status.state) == (0, "idle")
     after = lab.recommend_now(1)  # the node goes on serving
     assert after.status == 4 and len(after.result.proposals) == 1
 
     # a deactivation stops a running recommendation too (aborted, nothing stored), and activation resumes serving
-    feedback.clear()
-    goal = long_goal_optimizing(lab, feedback, learn_first=False)
-    assert lab.transition(Transition.TRANSITION_DEACTIVATE)
+    goal = gate.held_goal(lab)
+    transition = lab.change_state.call_async(ChangeState.Request(
+        transition=Transition(id=Transition.TRANSITION_DEACTIVATE)))
+    wait_until(lambda: stopping_logged(planner), "the node stopping the held recommendation")
+    assert "was deactivated" in planner.output()
+    gate.release()
     outcome = lab.wait(goal.get_result_async(), "the aborted result")
     assert outcome.status == 6 and "deactivated" in outcome.result.error, outcome  # GoalStatus.STATUS_ABORTED
+    assert lab.wait(transition, "the deactivation").success
     assert lab.transition(Transition.TRANSITION_ACTIVATE)
     assert lab.status().n_pending == 1  # the one of `after`, still owed
     assert lab.recommend_now(1).status == 4
 
 
-def test_a_recommendation_running_when_the_node_is_stopped_is_aborted_with_the_reason(lab, start_planner):
-    planner = start_planner(LONG_CONFIG, auto_propose=False)
-    goal = long_goal_optimizing(lab, [])
+def test_a_recommendation_running_when_the_node_is_stopped_is_aborted_with_the_reason(lab, start_planner, tmp_path):
+    gate = Gate(tmp_path)
+    planner = start_planner(gate.config, auto_propose=False)
+    learn_two_results(lab)
+    goal = gate.held_goal(lab)
     planner.process.send_signal(signal.SIGINT)  # Ctrl-C, as an operator stops a node
+    wait_until(lambda: stopping_logged(planner), "the node stopping the held recommendation")
+    gate.release()
     outcome = lab.wait(goal.get_result_async(), "the aborted result")
     assert outcome.status == 6, outcome  # GoalStatus.STATUS_ABORTED
     assert "shutting down" in outcome.result.error and not outcome.result.proposals

@@ -15,3 +15,29 @@ def exploding(options):
     def constraint(params):
         raise RuntimeError("interlock controller unreachable")
     return constraint
+
+
+def gate(options):
+    """Feasible everywhere, vectorized. While the file `hold` exists, a call writes `<hold>.held` and waits until
+    `hold` is removed (at most `timeout_s`): a test holds a recommendation in the middle of its optimization, however
+    fast the machine, and releases it once its cancel or stop request has been taken."""
+    import time
+    from pathlib import Path
+
+    import numpy as np
+
+    from gryffin_ros.planner import vectorized
+
+    hold = Path(options["hold"])
+    held = hold.with_name(hold.name + ".held")
+    timeout_s = float(options.get("timeout_s", 120.0))
+
+    @vectorized
+    def constraint(columns):
+        if hold.exists():
+            held.touch()
+            deadline = time.monotonic() + timeout_s
+            while hold.exists() and time.monotonic() < deadline:
+                time.sleep(0.01)  # polls the condition (the file's removal), not a stand-in for it
+        return np.ones(len(next(iter(columns.values()))), dtype=bool)
+    return constraint

@@ -168,7 +168,7 @@ class PlannerNode(LifecycleNode):
         """Refuse new work, stop the running recommendations (at their next checkpoint), then remove the inputs."""
         self._active = False
         if self.campaign is not None:
-            self.campaign.stop_serving(SHUTTING_DOWN if self._closing else DEACTIVATED)
+            self._stop_asks(SHUTTING_DOWN if self._closing else DEACTIVATED, wait=True)
         for destroy, entity in self._inputs:
             destroy(entity)
         self._inputs, self._guard = [], None
@@ -209,7 +209,15 @@ class PlannerNode(LifecycleNode):
         the executor still spins to deliver it (`settled` says when they are done)."""
         self._closing = True
         if self.campaign is not None:
-            self.campaign.stop_serving(SHUTTING_DOWN, wait=False)
+            self._stop_asks(SHUTTING_DOWN, wait=False)
+
+    def _stop_asks(self, reason: str, wait: bool) -> None:
+        """Stop serving asks; the running ones stop at their next checkpoint (said in the log: an operator sees why
+        a deactivation or a stop waits)."""
+        running = self.campaign.asks.in_progress()
+        if running:
+            self.get_logger().info(f"stopping {running} recommendation(s) in progress: {reason}")
+        self.campaign.stop_serving(reason, wait=wait)
 
     def settled(self) -> bool:
         """No recommendation is running (each stopped one has handed its goal its result)."""

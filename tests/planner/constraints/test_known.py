@@ -1,5 +1,7 @@
 """Known constraints: callables, expressions, plugins; errors that name the constraint; the feasible fraction V_C."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -88,6 +90,15 @@ def test_contradictory_constraints_give_a_clear_error_not_a_hang():
     c = KnownConstraints.build(SQUARE, ["x0 < 0.2", "x0 > 0.8"])
     with pytest.raises(NoFeasiblePointError, match="no point satisfying the known constraints"):
         estimate_feasible_fraction(c, np.random.default_rng(0), max_samples=100_000)
+
+
+def test_a_plugin_may_return_a_vectorized_constraint(monkeypatch, tmp_path):
+    """A factory's callable decorated with `vectorized` gets column arrays, per point as for a batch."""
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "plugin_package"))
+    c = KnownConstraints.build(SQUARE, [{"plugin": "test_gate", "options": {"hold": str(tmp_path / "hold")}}])
+    assert c.constraints[0].columns_fn is not None
+    assert c.feasible(np.random.default_rng(0).random((50, 2))).tolist() == [True] * 50
+    assert c.is_feasible({"x0": 0.3, "x1": 0.9})
 
 
 def test_lookup_plugin_accepts_exactly_the_listed_rows(tmp_path):

@@ -23,7 +23,7 @@ from ..space import Parameter
 from ..suggest import suggestion
 from .expressions import Expression
 from .literals import matches_option, option_list, unknown_option
-from .named import NamedConstraint
+from .named import NamedConstraint, callable_constraint
 from .specs import EXPRESSION_OPTIONS, ConstraintSpec
 
 PLUGIN_GROUP = "gryffin_ros.constraints"
@@ -149,6 +149,9 @@ def load_plugin(name: str, options: Mapping[str, Any], parameters: Parameters) -
         return constraint
     if not callable(constraint):
         raise ConfigError(f"constraint plugin '{name}' returned {type(constraint).__name__}, not a callable")
+    if getattr(constraint, "vectorized", False):  # decorated with `vectorized`: takes column arrays
+        wrapped = callable_constraint(constraint, 0)
+        return NamedConstraint(getattr(constraint, "name", name), wrapped.fn, wrapped.columns_fn)
     return NamedConstraint(getattr(constraint, "name", name), constraint, getattr(constraint, "evaluate_columns", None))
 
 
