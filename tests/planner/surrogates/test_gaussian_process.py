@@ -75,6 +75,26 @@ def test_descriptor_columns_of_categorical_parameters_keep_a_length_scale_floor(
     assert lengthscale[2] >= floor * (1 - 1e-9)
     assert lengthscale[2] < 2 * floor  # the data push it down to the floor: a floor that holds, not an idle one
 
+def test_a_space_of_categorical_options_without_descriptors_fits_and_recommends():
+    """Only options, no descriptors: no input has a Matern length scale (no floors at all), and the GP still fits,
+    predicts the options it has seen in order, and recommends (an empty per-input bound once broke every ask of the
+    paper's surfaces without descriptors)."""
+    options = [f"x_{i}" for i in range(6)]
+    config = {"parameters": [{"name": n, "type": "categorical", "options": options} for n in ("a", "b")],
+              "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
+    space = SearchSpace.from_config(config["parameters"])
+    assert Features(space).lengthscale_floors.numel() == 0
+    params = [{"a": options[i % 6], "b": options[(i * 5 + 1) % 6]} for i in range(12)]
+    y = np.array([float(options.index(p["a"])) for p in params])
+    gp = GaussianProcess(space, space.to_internal(params), y, seed=0)
+    mean = gp.model.posterior(gp.features.of(space.to_internal(params[:6]))).mean.detach().numpy().ravel()
+    assert np.all(np.diff(mean) > 0)  # options a = x_0 ... x_5, results 0 ... 5
+    planner = Planner(config, seed=0)
+    planner.tell([{**p, "y": float(v)} for p, v in zip(params, y)])
+    (proposal,) = planner.ask()
+    assert proposal.params["a"] in options and proposal.meta.get("surrogate") == "gp"
+
+
 def test_rank_correlation():
     a = np.array([1.0, 2.0, 3.0, 4.0])
     assert rank_correlation(a, a ** 3) == pytest.approx(1.0)
@@ -418,7 +438,7 @@ def test_with_failures_the_gp_weights_expected_improvement_itself_by_the_probabi
         def probability(self, X):
             return np.array([0.5, 0.25, 1.0])
 
-    planner = Planner(config("gp"), seed=0)
+    planner = Planner(config("gp", feas_approach="fwa"), seed=0)
     start = np.array([[0.1, 0.1], [0.5, 0.5], [0.9, 0.9]])
     _, alpha = planner._candidates(Acquisition(True), start, True, None, np.random.default_rng(0), Feasibility())
     np.testing.assert_allclose(alpha, [3.0 + np.log(2), 1.0 + np.log(4), 7.0], rtol=1e-12)

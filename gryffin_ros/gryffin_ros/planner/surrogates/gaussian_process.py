@@ -183,8 +183,12 @@ class GaussianProcess:
         likelihood.noise_covar.register_constraint("raw_noise", GreaterThan(MIN_NOISE))
         # ARD Matern-5/2 without hyperpriors: the marginal likelihood alone, as in GPyOpt, within bounds that keep a
         # smooth trend (a quadratic bowl, a slope) from pushing length and output scales to infinity
-        matern = partial(MaternKernel, nu=2.5, lengthscale_constraint=Interval(
-            self.features.lengthscale_floors, torch.full_like(self.features.lengthscale_floors, LENGTHSCALE_BOUNDS[1])))
+        floors = self.features.lengthscale_floors
+        # per input; with categorical options only (no descriptors) no Matern kernel is made, and gpytorch refuses
+        # an Interval of empty bounds
+        bounds = (Interval(floors, torch.full_like(floors, LENGTHSCALE_BOUNDS[1])) if len(floors)
+                  else Interval(*LENGTHSCALE_BOUNDS))
+        matern = partial(MaternKernel, nu=2.5, lengthscale_constraint=bounds)
         if self.features.cat_dims:
             self.model = MixedSingleTaskGP(train_X, train_Y, cat_dims=self.features.cat_dims, likelihood=likelihood,
                                            cont_kernel_factory=matern, outcome_transform=Standardize(m=1))
