@@ -69,11 +69,8 @@ class GeneralSettings:
     random_seed: int | None = None
     max_rejection_draws: int = 1_000_000
     softness: float = 1e-3
-    # fca, not Gryffin's fwa: on the paper's surfaces with their constraints unknown, Michalewicz's optimum (a small
-    # feasible island in a failing ring) took 37.5 evaluations with fwa, 22.6 with fca (Atlas 23.4); fwa let the
-    # failure model's wide kernels outweigh the acquisition beside the island (benchmarks/README.md, "Failed
-    # experiments as unknown constraints")
-    feas_approach: str = "fca"
+    # fwt, not Gryffin's fwa: P(feasible) counts as 1 from 0.5 up (acquisition/feasibility.py, FWT_THRESHOLD)
+    feas_approach: str = "fwt"
     feas_param: float = 1.0
     feas_model: str = "kde"
     auto_desc_gen: bool = False
@@ -94,7 +91,7 @@ _GENERAL_TYPES: dict[str, tuple[type, ...]] = {
 # obj_transform: Gryffin's None (no transform) is our `identity`
 _GENERAL_CHOICES = {"acquisition_optimizer": {"adam", "genetic"},
                     "obj_transform": {"sqrt", "cbrt", "square", "identity"},
-                    "feas_approach": {"fwa", "fia", "fca"}, "feas_model": {"kde", "gp"},
+                    "feas_approach": {"fwt", "fwa", "fia", "fca"}, "feas_model": {"kde", "gp"},
                     "kernel_width": {"auto", "spacing", "gryffin"},
                     "surrogate": {"portfolio", "kde", "gp", "auto"}}
 

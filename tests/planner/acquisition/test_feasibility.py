@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-from gryffin_ros.planner import Planner
+from gryffin_ros.planner import Planner, load_config
 from gryffin_ros.planner.acquisition.feasibility import FeasibilityModel, combine
 
 SQUARE = {"parameters": [{"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0},
@@ -36,6 +36,7 @@ def test_combinations_follow_their_definitions():
     alpha = np.array([0.0, 0.5, 1.0])
     p = np.array([0.2, 0.9, 1.0])
     assert combine(alpha, p, "fwa", 1.0, 0.5) == pytest.approx([-0.2, -0.45, 0.0])
+    assert combine(alpha, p, "fwt", 1.0, 0.5) == pytest.approx([-0.4, -0.5, 0.0])  # P / 0.5, at most 1
     w = 0.5 ** 2.0
     assert combine(alpha, p, "fia", 2.0, 0.5) == pytest.approx(w * (1 - p) + (1 - w) * np.array([0, 0.5, 1]))
     assert combine(alpha, p, "fca", 0.5, 0.5).tolist() == [np.inf, 0.5, 1.0]
@@ -53,7 +54,18 @@ def test_with_every_experiment_failed_the_next_proposals_go_away_from_the_failur
         assert min(np.hypot(*(x - [f["x0"], f["x1"]])) for f in failures) > 0.25
 
 
-@pytest.mark.parametrize("approach", ["fwa", "fia", "fca"])
+def test_the_default_lets_a_likely_feasible_best_candidate_win_that_fwa_gives_away():
+    """The best acquisition at P = 0.6 (beside a few failures) against a slightly worse one at P = 1: fwa's product
+    prefers the worse one, fwt (the default) counts P from 0.5 up as feasible and keeps the best; a candidate at
+    P = 0.2 is still weighed down, not cut off as fca would."""
+    alpha, p = np.array([0.0, 0.2, 1.0, 0.0]), np.array([0.6, 1.0, 1.0, 0.2])
+    assert load_config(SQUARE).general.feas_approach == "fwt"
+    assert int(np.argmin(combine(alpha, p, "fwa", 1.0, 0.3))) == 1
+    scores = combine(alpha, p, "fwt", 1.0, 0.3)
+    assert int(np.argmin(scores)) == 0 and np.isfinite(scores[3]) and scores[3] < scores[2]
+
+
+@pytest.mark.parametrize("approach", ["fwt", "fwa", "fia", "fca"])
 def test_every_feasibility_approach_proposes_feasible_points(approach):
     config = {**SQUARE, "constraints": ["x0 + x1 <= 1.5"], "general": {"feas_approach": approach}}
     planner = Planner(config, seed=2)

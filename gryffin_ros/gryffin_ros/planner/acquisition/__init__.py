@@ -16,7 +16,7 @@ from .kernel import Acquisition
 
 class AcquisitionFunction(Protocol):
     # the scale of the values: True for -log of a positive acquisition (the GP's -log EI: weighting by P(feasible) is
-    # adding -log P), False for Gryffin's kernel acquisition (combined with P(feasible) by fwa/fia/fca)
+    # adding -log P), False for Gryffin's kernel acquisition (combined with P(feasible) by fwt/fwa/fia/fca)
     log_scale: bool
 
     def evaluate(self, X: np.ndarray) -> np.ndarray:

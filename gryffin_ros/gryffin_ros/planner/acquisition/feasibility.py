@@ -1,5 +1,5 @@
 """Unknown constraints learned from failed experiments: P(feasible | x) from the kernel densities of successful and
-failed observations, and its combination with the acquisition (fwa, fia, fca).
+failed observations, and its combination with the acquisition (fwt, fwa, fia, fca).
 
 Two kernel estimates, each P = (sum_{k ok} p_k(x) + prior * u) / (sum_k p_k(x) + u), u = 1/V the uniform density
 acting as one prior pseudo-observation. The wide one (kernels as broad as the spacing of the data, descriptors
@@ -23,8 +23,20 @@ from ..space import SearchSpace
 from ..surrogates.kernel_density import KernelDensity
 from .kernel import Acquisition
 
-APPROACHES = ("fwa", "fia", "fca")
+APPROACHES = ("fwt", "fwa", "fia", "fca")
 FCA_MIN_PASSING = 0.1
+# fwt (the default): fwa with P(feasible) counted as 1 from this value up. fwa's product let a good candidate beside a
+# few failures (P ~ 0.6: the failure model's kernels are as wide as the data's spacing) lose to poorer ones far from
+# them; fca's hard cut (P > 0.5 only) kept a cell whose options all failed elsewhere out until almost every other one
+# was tried (Michalewicz without descriptors: 2 of 30 seeds at 440 of 441). benchmarks/README.md, round four.
+FWT_THRESHOLD = 0.5
+
+
+def weight(p_feasible: np.ndarray, approach: str) -> np.ndarray:
+    """The factor fwa and fwt weigh the acquisition by: P itself (fwa), or P / FWT_THRESHOLD up to 1 (fwt)."""
+    if approach == "fwt":
+        return np.minimum(1.0, p_feasible / FWT_THRESHOLD)
+    return p_feasible
 
 
 def no_descriptors(space: SearchSpace) -> dict[int, None]:
@@ -75,12 +87,13 @@ class FeasibilityModel:
 def combine(alpha: np.ndarray, p_feasible: np.ndarray, approach: str, feas_param: float,
             fraction_failed: float) -> np.ndarray:
     """The score to minimize over a candidate set, from alpha and P(feasible). alpha is first rescaled to a in [0, 1]
-    over the set. fwa: -(1 - a) P. fia: w (1 - P) + (1 - w) a, w = fraction_failed^feas_param. fca: a where
-    P > threshold (feas_param, halved until at least 10 % of the candidates pass), +inf elsewhere."""
+    over the set. fwa: -(1 - a) P; fwt: -(1 - a) min(1, P / FWT_THRESHOLD). fia: w (1 - P) + (1 - w) a,
+    w = fraction_failed^feas_param. fca: a where P > threshold (feas_param, halved until at least 10 % of the
+    candidates pass), +inf elsewhere."""
     span = alpha.max() - alpha.min()
     a = (alpha - alpha.min()) / span if span > 0 else np.zeros_like(alpha)
-    if approach == "fwa":
-        return -(1.0 - a) * p_feasible
+    if approach in ("fwa", "fwt"):
+        return -(1.0 - a) * weight(p_feasible, approach)
     if approach == "fia":
         w = fraction_failed ** feas_param
         return w * (1.0 - p_feasible) + (1.0 - w) * a

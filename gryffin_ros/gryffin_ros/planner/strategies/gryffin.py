@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import torch
 
-from ..acquisition.feasibility import FeasibilityModel, combine
+from ..acquisition.feasibility import FeasibilityModel, combine, weight
 from ..acquisition.kernel import Acquisition
 from ..config import PlannerConfig
 from ..constraints.sampling import perturb, rejection_sample, spread_seeds
@@ -266,10 +266,11 @@ class Planner(BasePlanner):
         if feasibility is not None:
             general = self.config.general
             probability = feasibility.probability(candidates)
-            if general.feas_approach == "fwa" and acquisition.log_scale:
-                # the GP's EI weighted by P(feasible) itself (constrained EI, Gardner et al. 2014), in log space: its
-                # min-max rescaled value is nearly flat where EI is small, and failing regions kept their weight
-                alpha = alpha - np.log(np.maximum(probability, MIN_PROBABILITY))
+            if general.feas_approach in ("fwa", "fwt") and acquisition.log_scale:
+                # the GP's EI weighted by P(feasible) itself (constrained EI, Gardner et al. 2014; fwt: P up to its
+                # threshold), in log space: its min-max rescaled value is nearly flat where EI is small, and failing
+                # regions kept their weight
+                alpha = alpha - np.log(np.maximum(weight(probability, general.feas_approach), MIN_PROBABILITY))
             else:
                 alpha = combine(alpha, probability, general.feas_approach, general.feas_param,
                                 feasibility.fraction_failed)
