@@ -72,7 +72,6 @@ class Gate:
         self.hold.unlink()
 
 
-
 def wait_until(condition, what: str, timeout: float = HANG_S, fail: bool = True):
     deadline = time.monotonic() + timeout
     while not (value := condition()):
