@@ -36,6 +36,8 @@ PLUGIN_PATH = Path(__file__).resolve().parents[1] / "plugin_package"
 # about 5 s there, an ask takes about a second, discovery and an answer well under one), so a slow machine waits
 # longer but never fails a test that a fast one passes; a passing test never waits for a deadline.
 HANG_S = 180.0
+# a status query not answered this long after is sent again (answers take well under a second there)
+STATUS_RESEND_S = 5.0
 FLOW_CONFIG = {
     "name": "flow_test",
     "parameters": [{"name": "F_C", "type": "continuous", "low": 0.0, "high": 200.0},
@@ -83,7 +85,19 @@ class Client(Node):
         return future.result()
 
     def status(self) -> dict:
-        return json.loads(self.call(self.status_client).message)
+        """The planner's status; asked again while the answer does not come (a node that has not yet matched this
+        side's answer reader drops its answer)."""
+        deadline = time.monotonic() + HANG_S
+        while True:
+            assert self.status_client.wait_for_service(timeout_sec=HANG_S), "get_status not available"
+            future = self.status_client.call_async(Trigger.Request())
+            answered = time.monotonic() + STATUS_RESEND_S
+            while not future.done() and time.monotonic() < answered:
+                time.sleep(0.01)
+            if future.done():
+                return json.loads(future.result().message)
+            self.status_client.remove_pending_request(future)
+            assert time.monotonic() < deadline, f"no status in {HANG_S:.0f} s of asking"
 
     def recommend(self) -> Trigger.Response:
         return self.call(self.recommend_client)
@@ -199,11 +213,23 @@ def start_emulator(supervisor: Supervisor, tmp_path: Path, *args: str) -> subpro
                             stderr=subprocess.DEVNULL)
 
 
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """A failed test's report carries the end of its planner nodes' output (CI keeps nothing else of them)."""
+    outcome = yield
+    report = outcome.get_result()
+    if report.failed:
+        for process in getattr(item, "planner_processes", []):
+            report.sections.append((f"planner node output ({process.log_path.name}, last 60 lines)",
+                                    "\n".join(process.output().splitlines()[-60:])))
+
+
 @pytest.fixture
-def start_planner(tmp_path, lab_session):
+def start_planner(request, tmp_path, lab_session):
     """Start a planner node; unless told otherwise wait until it runs and its latched status reached the lab client
     (a node of an earlier test may still be known to DDS for a moment, so its service is no sign of the new one)."""
     started: list[PlannerProcess] = []
+    request.node.planner_processes = started
 
     def start(config: dict = FLOW_CONFIG, wait: bool = True, ros_args: tuple[str, ...] = (),
               **params) -> PlannerProcess:
