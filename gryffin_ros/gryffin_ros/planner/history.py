@@ -23,7 +23,7 @@ class History:
     observations: list[Observation] = field(default_factory=list)
     pending: dict[str, Proposal] = field(default_factory=dict)
     ask_count: int = 0
-    proposal_count: int = 0
+    proposal_count: int = 0  # proposals that took a sampling strategy (`BasePlanner.proposal_count`)
 
     def __post_init__(self) -> None:
         # derived once here and grown with add_observations (a campaign takes a snapshot per observation and reads

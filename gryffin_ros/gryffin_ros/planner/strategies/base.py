@@ -78,7 +78,7 @@ class BasePlanner:
         self._successful: tuple[Observation, ...] = ()
         self._values = np.empty((0, len(self.objectives)))
         self._values_upto, self._values_last = 0, None
-        self._drawn = 0  # while an ask runs: proposals drawn so far in the campaign (sampling strategies cycle)
+        self._drawn = 0  # while an ask runs: proposals that took a sampling strategy so far (they cycle with it)
         # the feasible region of the known constraints: V_C, uniform and walked feasible draws, a finite feasible set
         self.region = FeasibleRegion(self.constraints, self.config.general, self.seed)
         self._strategies: np.ndarray | None = None  # sampling strategies replacing the config's (recommend)
@@ -104,7 +104,9 @@ class BasePlanner:
 
     @property
     def proposal_count(self) -> int:
-        """How many proposals have been made (the sampling strategies cycle with it)."""
+        """How many proposals have taken one of the sampling strategies, which cycle with it: the kernel density's.
+        Proposals of the GP and random ones take none and leave it as it was (so it is not the number of proposals
+        made; that is the store's count of proposals)."""
         return self.history.proposal_count
 
     # ---- randomness ------------------------------------------------------------------------------------------
