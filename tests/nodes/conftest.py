@@ -36,8 +36,9 @@ PLUGIN_PATH = Path(__file__).resolve().parents[1] / "plugin_package"
 # about 5 s there, an ask takes about a second, discovery and an answer well under one), so a slow machine waits
 # longer but never fails a test that a fast one passes; a passing test never waits for a deadline.
 HANG_S = 180.0
-# a status query not answered this long after is sent again (answers take well under a second there)
-STATUS_RESEND_S = 5.0
+# a query (a request that changes nothing) not answered this long after is sent again (answers take well under a
+# second there)
+QUERY_RESEND_S = 5.0
 FLOW_CONFIG = {
     "name": "flow_test",
     "parameters": [{"name": "F_C", "type": "continuous", "low": 0.0, "high": 200.0},
@@ -50,6 +51,23 @@ FLOW_CONFIG = {
 
 def flow_feasible(p: dict) -> bool:
     return 30 < p["F_C"] + p["F_S"] < 310 and p["F_C"] < 2 * p["F_S"] and p["F_S"] < 2 * p["F_C"]
+
+
+def query(client, request):
+    """The answer to a request that changes nothing, sent again while the answer does not come: a service is
+    "available" as soon as this side matched the node, but the node may not have matched this side's answer reader
+    yet, and then drops its answer (CI lost a lifecycle answer that way: a 180 s hang)."""
+    deadline = time.monotonic() + HANG_S
+    while True:
+        assert client.wait_for_service(timeout_sec=HANG_S), f"{client.srv_name} not available"
+        future = client.call_async(request)
+        resend_at = time.monotonic() + QUERY_RESEND_S
+        while not future.done() and time.monotonic() < resend_at:
+            time.sleep(0.01)
+        if future.done():
+            return future.result()
+        client.remove_pending_request(future)
+        assert time.monotonic() < deadline, f"no answer from {client.srv_name} in {HANG_S:.0f} s of resending"
 
 
 class Client(Node):
@@ -85,19 +103,7 @@ class Client(Node):
         return future.result()
 
     def status(self) -> dict:
-        """The planner's status; asked again while the answer does not come (a node that has not yet matched this
-        side's answer reader drops its answer)."""
-        deadline = time.monotonic() + HANG_S
-        while True:
-            assert self.status_client.wait_for_service(timeout_sec=HANG_S), "get_status not available"
-            future = self.status_client.call_async(Trigger.Request())
-            answered = time.monotonic() + STATUS_RESEND_S
-            while not future.done() and time.monotonic() < answered:
-                time.sleep(0.01)
-            if future.done():
-                return json.loads(future.result().message)
-            self.status_client.remove_pending_request(future)
-            assert time.monotonic() < deadline, f"no status in {HANG_S:.0f} s of asking"
+        return json.loads(query(self.status_client, Trigger.Request()).message)
 
     def recommend(self) -> Trigger.Response:
         return self.call(self.recommend_client)

@@ -31,7 +31,7 @@ from rclpy.qos import qos_profile_system_default
 from gryffin_ros.nodes.qos import EVENTS_QOS, OBSERVATIONS_QOS
 from gryffin_ros.paths import share_path
 
-from .conftest import FLOW_CONFIG, HANG_S, flow_feasible, node_env, spinning, start_emulator
+from .conftest import FLOW_CONFIG, HANG_S, flow_feasible, node_env, query, spinning, start_emulator
 
 EXAMPLES = share_path("examples")
 # client rule (docs/ros.md): a goal not accepted within this long is sent again under the same instrument name; a
@@ -117,21 +117,8 @@ class TypedLab(Node):
         assert client.wait_for_service(timeout_sec=timeout), f"{client.srv_name} not available"
         return self.wait(client.call_async(request), f"an answer from {client.srv_name}", timeout)
 
-    def query(self, client, request):
-        """The answer to a request that changes nothing, sent again while the answer does not come: a service is
-        "available" as soon as this side matched the new node, but the node may not have matched this side's answer
-        reader yet, and then drops its answer (CI lost a lifecycle answer that way: a 180 s hang)."""
-        deadline = time.monotonic() + HANG_S
-        while True:
-            assert client.wait_for_service(timeout_sec=HANG_S), f"{client.srv_name} not available"
-            future = client.call_async(request)
-            if wait_until(future.done, f"an answer from {client.srv_name}", RESEND_S, fail=False):
-                return future.result()
-            client.remove_pending_request(future)
-            assert time.monotonic() < deadline, f"no answer from {client.srv_name} in {HANG_S:.0f} s of resending"
-
     def state(self) -> str:
-        return self.query(self.get_state, GetState.Request()).current_state.label
+        return query(self.get_state, GetState.Request()).current_state.label
 
     def transition(self, transition_id: int) -> bool:
         """A lifecycle transition, sent once (sending it again is not the same request); an answered query to the
@@ -140,7 +127,7 @@ class TypedLab(Node):
         return self.call(self.change_state, ChangeState.Request(transition=Transition(id=transition_id))).success
 
     def status(self):
-        return self.query(self.get_status, GetStatus.Request()).status
+        return query(self.get_status, GetStatus.Request()).status
 
     def send_goal(self, count: int, feedback: list | None = None):
         """A Recommend goal under this client's instrument name, sent again while its acceptance does not arrive
@@ -338,7 +325,7 @@ def test_parameters_are_validated_when_set_and_read_only_ones_refuse(lab, start_
 def test_the_params_file_example_configures_the_node(lab, start_planner, tmp_path):
     example = EXAMPLES / "planner_params.yaml"
     start_planner(wait=True, ros_args=("--params-file", str(example)), storage=str(tmp_path / "p.sqlite"))
-    answer = lab.query(lab.get_parameters, GetParameters.Request(names=["batch_size", "max_message_bytes"]))
+    answer = query(lab.get_parameters, GetParameters.Request(names=["batch_size", "max_message_bytes"]))
     assert [v.integer_value for v in answer.values] == [2, 65536]
 
 
