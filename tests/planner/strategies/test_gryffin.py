@@ -295,3 +295,42 @@ def test_an_observation_is_converted_to_the_planners_coordinates_once_when_it_is
                         lambda self, rows: converted.append(len(rows)) or real(self, rows))
     assert planner.observed_points() == pytest.approx(np.array([[0.2, 1.0], [0.5, 0.0], [1.0, 0.0]]))
     assert converted == [1]  # only the stored one
+
+
+def test_a_gp_runs_each_option_of_a_small_categorical_twice_before_it_settles():
+    """The GP's expected improvement alone can leave options untried for a whole campaign; each option of a small
+    categorical parameter is run twice first (those the known constraints rule out never), the continuous
+    condition optimized under it, and the proposals say so. A 12-option parameter is left to its descriptors."""
+    solvents = {name: [float(i), float(i % 3)] for i, name in enumerate("ABCDEF")}
+    config = {"parameters": [{"name": "solvent", "type": "categorical", "descriptors": solvents},
+                             {"name": "T", "type": "continuous", "low": 0.0, "high": 1.0}],
+              "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"},
+              "constraints": ["solvent != 'F'"]}
+
+    def measure(p):  # A is best; the others get worse along the first descriptor
+        return "ABCDEF".index(p["solvent"]) + (p["T"] - 0.3) ** 2
+
+    planner = Planner(config, seed=0)
+    start = [{"solvent": s, "T": t} for s, t in (("A", 0.1), ("A", 0.8), ("B", 0.5), ("B", 0.2), ("A", 0.5))]
+    planner.tell([{**p, "y": measure(p)} for p in start])
+    runs = {s: 0 for s in "ABCDEF"}
+    for p in start:
+        runs[p["solvent"]] += 1
+    for _ in range(6):
+        (proposal,) = planner.ask()
+        solvent = proposal.params["solvent"]
+        runs[solvent] += 1
+        assert f"solvent={solvent}" in proposal.meta["covering"]
+        planner.tell({**proposal.params, "y": measure(proposal.params), "experiment_id": proposal.experiment_id})
+    assert runs == {"A": 3, "B": 2, "C": 2, "D": 2, "E": 2, "F": 0}  # 6 asks: C, D and E twice each
+    (proposal,) = planner.ask()  # every option run twice: the expected improvement alone again
+    assert "covering" not in proposal.meta
+
+    many = {**config, "parameters": [{"name": "solvent", "type": "categorical",
+                                      "descriptors": {f"S{i}": [float(i), float(i % 3)] for i in range(12)}},
+                                     config["parameters"][1]], "constraints": []}
+    planner = Planner(many, seed=0)
+    planner.tell([{"solvent": "S0", "T": t, "y": (t - 0.3) ** 2} for t in (0.1, 0.5, 0.8)]
+                 + [{"solvent": "S1", "T": t, "y": 1 + (t - 0.3) ** 2} for t in (0.2, 0.6)])
+    (proposal,) = planner.ask()
+    assert "covering" not in proposal.meta

@@ -26,4 +26,24 @@ class AcquisitionFunction(Protocol):
         """Values and their gradients with respect to the continuous coordinates."""
 
 
-__all__ = ["Acquisition", "AcquisitionFunction"]
+class Pinned:
+    """An acquisition restricted to the points whose finite dim `dim` holds option `option` (+inf elsewhere): the
+    optimizers' Hill moves and genetic children leave that option only for a worse value, so an optimization from
+    start points that hold it refines the other coordinates under it."""
+
+    def __init__(self, acquisition: AcquisitionFunction, dim: int, option: int):
+        self.acquisition, self.dim, self.option = acquisition, int(dim), int(option)
+        self.log_scale = acquisition.log_scale
+
+    def _off(self, X: np.ndarray) -> np.ndarray:
+        return np.rint(X[:, self.dim]) != self.option
+
+    def evaluate(self, X: np.ndarray) -> np.ndarray:
+        return np.where(self._off(X), np.inf, self.acquisition.evaluate(X))
+
+    def value_and_grad(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        alpha, grad = self.acquisition.value_and_grad(X)
+        return np.where(self._off(X), np.inf, alpha), grad
+
+
+__all__ = ["Acquisition", "AcquisitionFunction", "Pinned"]
