@@ -32,11 +32,14 @@ def check_blend(p):
     assert not (p["base"] == "DBU" and p["water"] > 0.5)
 
 
-@pytest.mark.parametrize("optimizer, asks", [pytest.param("adam", 20, marks=pytest.mark.slow), ("genetic", 8)])
+@pytest.mark.parametrize("optimizer, asks", [pytest.param("adam", 26, marks=pytest.mark.slow), ("genetic", 8)])
 def test_mixture_campaign_keeps_every_proposal_exact_and_feasible(optimizer, asks):
     """Both optimizers keep every proposal exact and feasible; the longer adam campaign also shows that the planner
     learns in the reduced coordinates (the genetic one runs 8 asks: its asks are the slowest of the suite, about 1.5 s
-    each, and what it must show, exact and feasible blends, holds from the first ask)."""
+    each, and what it must show, exact and feasible blends, holds from the first ask). The adam campaign is 20 asks
+    plus the 6 in which the GP runs each of the 3 bases twice (the options of a small categorical parameter come
+    first); seeds 0-15 of it reach 0.010-0.100 (one at 0.100), random search 0.052 on average, a base other than
+    Cs2CO3 costs 0.05: a check that the blends it proposes reach the good region, not a measure of efficiency."""
     planner = Planner(blend_config(general={"acquisition_optimizer": optimizer}), seed=3)
     assert planner.equalities.dependent == ("dmso",)  # the last component is solved for
     assert "dmso" not in planner.space.names and planner.parameter_names[2] == "dmso"
