@@ -238,7 +238,7 @@ class Planner(BasePlanner):
         if gp is not None:
             points, covered = self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen)
             if covered:
-                meta["covering"] = (f"options run fewer than {COVER_TRIES} times first: {', '.join(covered)}")
+                meta["covering"] = f"options run fewer than {COVER_TRIES} times first: {', '.join(covered)}"
             return points, [None] * n, meta
         return (*self._propose_kde(n, rng, density, start, exhaustive, feasibility, observed, chosen), meta)
 
@@ -307,9 +307,10 @@ class Planner(BasePlanner):
         from ..acquisition.gp import GPAcquisition  # BoTorch: loaded by the planners that use a GP
         optimizer = self.optimizer()
         candidates, alpha = self._candidates(GPAcquisition(gp), start, exhaustive, optimizer, rng, feasibility)
-        if not exhaustive and self.under_tried(np.concatenate([observed, chosen])):
-            pinned, pinned_alpha = self._covering_candidates(GPAcquisition(gp), candidates, alpha, optimizer, rng,
-                                                             feasibility, np.concatenate([observed, chosen]))
+        under = self.under_tried(np.concatenate([observed, chosen]))
+        if under and not exhaustive:
+            pinned, pinned_alpha = self._covering_candidates(GPAcquisition(gp), under, candidates, alpha, optimizer,
+                                                             rng, feasibility)
             candidates, alpha = np.concatenate([candidates, pinned]), np.concatenate([alpha, pinned_alpha])
         points, covered = [], []
         spacing = batch_spacing(self.space, n, self.feasible_fraction.value)
@@ -320,7 +321,8 @@ class Planner(BasePlanner):
                 candidates, alpha = self._candidates(GPAcquisition(gp), candidates, True, optimizer, rng, feasibility)
                 alpha = apart(self.space, candidates, alpha, np.array(points), spacing)
             x = None
-            under = self.under_tried(np.concatenate([observed, chosen]))
+            if i:
+                under = self.under_tried(np.concatenate([observed, chosen]))
             if under:
                 holds = np.zeros(len(candidates), dtype=bool)
                 for d, option in under:
@@ -352,15 +354,16 @@ class Planner(BasePlanner):
             out += [(int(d), int(o)) for o in np.flatnonzero(counts < COVER_TRIES)]
         return out
 
-    def _covering_candidates(self, acquisition: AcquisitionFunction, candidates: np.ndarray, alpha: np.ndarray,
-                             optimizer: AcquisitionOptimizer, rng: np.random.Generator,
-                             feasibility: FeasibilityModel | None, tried: np.ndarray
+    def _covering_candidates(self, acquisition: AcquisitionFunction, under: list[tuple[int, int]],
+                             candidates: np.ndarray, alpha: np.ndarray, optimizer: AcquisitionOptimizer,
+                             rng: np.random.Generator, feasibility: FeasibilityModel | None
                              ) -> tuple[np.ndarray, np.ndarray]:
-        """For each under-tried option: the COVER_STARTS best candidates with that option set (those still feasible)
-        and the candidates that hold it, optimized with the option pinned; the results that kept it, scored."""
+        """For each under-tried (dim, option) of `under`: the COVER_STARTS best candidates with that option set (those
+        still feasible) and the candidates that hold it, optimized with the option pinned; the results that kept it,
+        scored."""
         best = candidates[np.argsort(alpha, kind="stable")[:COVER_STARTS]]
         found, scores = [np.empty((0, self.space.dim))], [np.empty(0)]
-        for d, option in self.under_tried(tried):
+        for d, option in under:
             moved = best.copy()
             moved[:, d] = option
             holding = np.flatnonzero(np.rint(candidates[:, d]) == option)
