@@ -304,7 +304,8 @@ def matern_without_prior(bounds, prior_inputs, ard_num_dims, batch_shape=None, a
 
 def test_a_fit_retried_from_the_prior_draws_the_length_scales_that_have_one_within_their_bounds():
     """When no attempt of a fit converges, BoTorch retries from hyperparameters drawn from their priors
-    (`sample_all_priors`; it crashed every such fit of the paper's Branin once): the continuous input's and the
+    (`sample_all_priors`; a prior registered without a way to set its values made every such retry raise, as on the
+    paper's Branin while this prior was measured): the continuous input's and the
     descriptor column's length scales are drawn, within their bounds, and the ordinal input's is kept."""
     space = SearchSpace.from_config([
         {"name": "t", "type": "continuous", "low": 0, "high": 1},
