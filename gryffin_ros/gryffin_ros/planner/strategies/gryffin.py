@@ -306,11 +306,12 @@ class Planner(BasePlanner):
         gp.believe(chosen)
         from ..acquisition.gp import GPAcquisition  # BoTorch: loaded by the planners that use a GP
         optimizer = self.optimizer()
-        candidates, alpha = self._candidates(GPAcquisition(gp), start, exhaustive, optimizer, rng, feasibility)
+        acquisition = GPAcquisition(gp)
+        candidates, alpha = self._candidates(acquisition, start, exhaustive, optimizer, rng, feasibility)
         under = self.under_tried(np.concatenate([observed, chosen]))
         if under and not exhaustive:
-            pinned, pinned_alpha = self._covering_candidates(GPAcquisition(gp), under, candidates, alpha, optimizer,
-                                                             rng, feasibility)
+            pinned, pinned_alpha = self._covering_candidates(acquisition, under, candidates, alpha, optimizer, rng,
+                                                             feasibility)
             candidates, alpha = np.concatenate([candidates, pinned]), np.concatenate([alpha, pinned_alpha])
         points, covered = [], []
         spacing = batch_spacing(self.space, n, self.feasible_fraction.value)
