@@ -499,9 +499,11 @@ def test_hyperparameters_are_fitted_to_the_best_and_a_seeded_draw_of_the_rest_be
     assert not np.array_equal(subset, fit_subset(y, seed=2))
 
 
-def test_with_failures_the_gp_weights_expected_improvement_itself_by_the_probability_of_success():
-    """fwa with the GP: -log EI - log P (constrained EI), so halving P(feasible) costs log 2 whatever EI is; the
-    kernel acquisition keeps Gryffin's rescaled -(1 - a) P."""
+def test_with_failures_the_gp_weights_expected_improvement_by_the_probability_of_success():
+    """fwa with the GP: -log EI - log P (constrained EI), so halving P(feasible) costs log 2 whatever EI is; fwt (the
+    default): -log EI - FEASIBILITY_POWER log min(1, P / 0.5); the kernel acquisition keeps Gryffin's rescaled
+    -(1 - a) P."""
+    from gryffin_ros.planner.strategies.gryffin import FEASIBILITY_POWER
     class Acquisition:
         def __init__(self, log_scale):
             self.log_scale = log_scale
@@ -521,6 +523,37 @@ def test_with_failures_the_gp_weights_expected_improvement_itself_by_the_probabi
     np.testing.assert_allclose(alpha, [3.0 + np.log(2), 1.0 + np.log(4), 7.0], rtol=1e-12)
     _, alpha = planner._candidates(Acquisition(False), start, True, None, np.random.default_rng(0), Feasibility())
     np.testing.assert_allclose(alpha, [-(1 - 1 / 3) * 0.5, -1.0 * 0.25, 0.0], rtol=1e-12)
+    planner = Planner(config("gp"), seed=0)
+    assert planner.config.general.feas_approach == "fwt" and FEASIBILITY_POWER > 1
+    _, alpha = planner._candidates(Acquisition(True), start, True, None, np.random.default_rng(0), Feasibility())
+    np.testing.assert_allclose(alpha, [3.0, 1.0 + FEASIBILITY_POWER * np.log(2), 7.0], rtol=1e-12)
+
+
+def test_a_failed_experiment_is_believed_no_better_than_the_incumbent():
+    """A failure where the GP, extrapolating the successes' trend, expects a better result than the best one is
+    believed at the incumbent, not at its mean: the mean there rises most of the way to the incumbent and the expected
+    improvement there falls by orders of magnitude; a pending experiment at the same point is believed at its mean,
+    which leaves the mean where it was."""
+    space = SearchSpace.from_config(config("gp")["parameters"])
+    rng = np.random.default_rng(5)
+    X = rng.random((20, 2)) * 0.5  # successes in the lower-left quarter only, the slope going on down beyond them
+    y = -(X[:, 0] + X[:, 1])
+    gp, pending = GaussianProcess(space, X, y, seed=0), GaussianProcess(space, X, y, seed=0)
+    failed = np.array([[0.9, 0.9]])
+    z = gp.features.of(failed)
+
+    def mean_at(model):
+        with torch.no_grad():
+            return float(model.posterior.mean_and_sigma(z)[0])
+
+    before, best, ei_before = mean_at(gp), gp.posterior.best, GPAcquisition(gp).evaluate(failed)[0]  # -log EI
+    assert before < best  # the GP expects an improvement there
+    gp.believe(failed, incumbent=False)
+    pending.believe(failed)
+    assert gp.posterior.best == best  # a failure never becomes the incumbent
+    assert mean_at(gp) > before + 0.5 * (best - before)
+    assert abs(mean_at(pending) - before) < 0.1 * (best - before)
+    assert GPAcquisition(gp).evaluate(failed)[0] > ei_before + 2.0  # EI at least e^2 times smaller
 
 
 def test_a_gp_batch_keeps_its_points_apart():
