@@ -1,9 +1,17 @@
-"""A hidden failing region: a smooth 2-d objective whose best feasible point sits at the edge of a quarter of the
-domain (x0 > 0.5 and x1 > 0.5) where every experiment fails (reported as None); the planner is not told. 60
-experiments per run, the first ones the planner's random initialization; reports how many of experiments 31-60 went
-inside the region (uniform sampling: 25 %), per run and in all.
+"""A hidden failing region: a smooth 2-d objective on the unit square and a region where every experiment fails
+(reported as None); the planner is not told. 60 experiments per run, the first ones the planner's random
+initialization; reports how many of experiments 31-60 went inside the region, and how many of those lay deep inside
+(every point within DEEP of them fails too: not a probe of the region's edge), per run and in all.
 
-    python -m benchmarks.failing_region [--seeds 5] [--feas-model kde|gp] [--surrogate kde|gp|auto|portfolio]
+Regions (--region):
+- edge (the default): the quarter x0 > 0.5 and x1 > 0.5; the best feasible point at (0.42, 0.64), beside its edge.
+- branin: Branin (rescaled to the unit square, / 100) with the quarter x0 > 0.5 and x1 < 0.5 failing: two of its
+  three minima inside; the third, (0.124, 0.818), is the best feasible point.
+- holds-optimum: (x0 - 0.65)^2 + (x1 - 0.7)^2 with the quarter x0 > 0.5 and x1 > 0.5 failing: the unconstrained
+  optimum inside, the best feasible points on the region's edge (where about half of any probes fail).
+
+    python -m benchmarks.failing_region [--seeds 5] [--region edge|branin|holds-optimum] [--feas-model kde|gp]
+                                        [--surrogate kde|gp|auto|portfolio] [--feas-approach fwt|fwa|fia|fca]
 """
 
 from __future__ import annotations
@@ -26,55 +34,81 @@ def objective(x0: float, x1: float) -> float:
     return (x0 - 0.45) ** 2 + (x1 - 0.6) ** 2 + 0.02 * math.sin(12 * x0) * math.cos(9 * x1)
 
 
-def best_feasible(steps: int = 1001) -> float:
+def branin(x0: float, x1: float) -> float:
+    a, b = 15 * x0 - 5, 15 * x1
+    return ((b - 5.1 / (4 * math.pi ** 2) * a ** 2 + 5 / math.pi * a - 6) ** 2
+            + 10 * (1 - 1 / (8 * math.pi)) * math.cos(a) + 10) / 100
+
+
+REGIONS = {  # name: (objective, fails)
+    "edge": (objective, inside),
+    "branin": (branin, lambda x0, x1: x0 > 0.5 and x1 < 0.5),
+    "holds-optimum": (lambda x0, x1: (x0 - 0.65) ** 2 + (x1 - 0.7) ** 2, inside),
+}
+DEEP = 0.03
+
+
+def deep(fails, x0: float, x1: float) -> bool:
+    """Every point of the square of half-width DEEP around (x0, x1), corners and edge midpoints, fails."""
+    return all(fails(x0 + a * DEEP, x1 + b * DEEP) for a in (-1, 0, 1) for b in (-1, 0, 1))
+
+
+def best_feasible(region: str = "edge", steps: int = 1001) -> float:
     """The objective's minimum outside the failing region, on a dense grid (the region's edge included)."""
     import numpy as np
+    f, fails = REGIONS[region]
     x0, x1 = np.meshgrid(np.linspace(0, 1, steps), np.linspace(0, 1, steps))
-    values = (x0 - 0.45) ** 2 + (x1 - 0.6) ** 2 + 0.02 * np.sin(12 * x0) * np.cos(9 * x1)
-    return float(values[~((x0 > 0.5) & (x1 > 0.5))].min())
+    values = np.vectorize(f)(x0, x1)
+    return float(values[~np.vectorize(fails)(x0, x1)].min())
 
 
-def run(seed: int, general: dict) -> tuple[int, float]:
-    """-> (experiments LATE + 1 .. EXPERIMENTS inside the failing region, best result)."""
+def run(seed: int, general: dict, region: str = "edge") -> tuple[int, int, float]:
+    """-> (experiments LATE + 1 .. EXPERIMENTS inside the failing region, those deep inside, best result)."""
     import torch
 
     from gryffin_ros.planner import Planner
     torch.set_num_threads(1)
+    f, fails = REGIONS[region]
     planner = Planner({**SQUARE, "general": general}, seed=seed)
-    late, best = 0, math.inf
+    late, late_deep, best = 0, 0, math.inf
     for experiment in range(1, EXPERIMENTS + 1):
         (proposal,) = planner.ask()
         x0, x1 = proposal.params["x0"], proposal.params["x1"]
-        failed = inside(x0, x1)
+        failed = fails(x0, x1)
         late += failed and experiment > LATE
-        best = best if failed else min(best, objective(x0, x1))
-        planner.tell({**proposal.params, "y": None if failed else objective(x0, x1),
+        late_deep += deep(fails, x0, x1) and experiment > LATE
+        best = best if failed else min(best, f(x0, x1))
+        planner.tell({**proposal.params, "y": None if failed else f(x0, x1),
                       "experiment_id": proposal.experiment_id})
-    return late, best
+    return late, late_deep, best
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("--region", default="edge", choices=list(REGIONS))
     parser.add_argument("--feas-model", default=None, help="general.feas_model (default: the planner's)")
     parser.add_argument("--surrogate", default=None, help="general.surrogate (default: the planner's)")
     parser.add_argument("--feas-approach", default=None, help="general.feas_approach (default: the planner's)")
     args = parser.parse_args()
     general = {k: v for k, v in (("feas_model", args.feas_model), ("surrogate", args.surrogate),
                                  ("feas_approach", args.feas_approach)) if v is not None}
-    optimum = best_feasible()
-    counts, regrets = [], []
+    optimum = best_feasible(args.region)
+    counts, deeps, regrets = [], [], []
     for seed in range(args.seeds):
-        count, best = run(seed, general)
+        count, count_deep, best = run(seed, general, args.region)
         counts.append(count)
+        deeps.append(count_deep)
         regrets.append(best - optimum)
-        print(f"seed {seed}: {count} of experiments {LATE + 1}-{EXPERIMENTS} inside, regret {regrets[-1]:.2e}",
-              flush=True)
+        print(f"seed {seed}: {count} of experiments {LATE + 1}-{EXPERIMENTS} inside ({count_deep} deep), regret "
+              f"{regrets[-1]:.2e}", flush=True)
     share = [100.0 * c / (EXPERIMENTS - LATE) for c in counts]
+    share_deep = [100.0 * c / (EXPERIMENTS - LATE) for c in deeps]
     se = statistics.stdev(share) / math.sqrt(len(share)) if len(share) > 1 else float("nan")
-    print(f"{general or 'default'}: {statistics.mean(share):.1f} ± {se:.1f} % of experiments {LATE + 1}-{EXPERIMENTS} "
-          f"inside the failing region, {args.seeds} seeds; regret (best - {optimum:.5f}) median "
-          f"{statistics.median(regrets):.2e}, worst {max(regrets):.2e}")
+    print(f"{args.region}, {general or 'default'}: {statistics.mean(share):.1f} ± {se:.1f} % of experiments "
+          f"{LATE + 1}-{EXPERIMENTS} inside the failing region ({statistics.mean(share_deep):.1f} % deep inside), "
+          f"{args.seeds} seeds; regret (best - {optimum:.5f}) median {statistics.median(regrets):.2e}, "
+          f"worst {max(regrets):.2e}")
 
 
 if __name__ == "__main__":
