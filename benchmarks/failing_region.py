@@ -20,6 +20,8 @@ import argparse
 import math
 import statistics
 
+from benchmarks.surfaces import branin
+
 EXPERIMENTS, LATE = 60, 30
 SQUARE = {"parameters": [{"name": n, "type": "continuous", "low": 0.0, "high": 1.0} for n in ("x0", "x1")],
           "objectives": [{"name": "y", "goal": "min"}]}
@@ -34,15 +36,9 @@ def objective(x0: float, x1: float) -> float:
     return (x0 - 0.45) ** 2 + (x1 - 0.6) ** 2 + 0.02 * math.sin(12 * x0) * math.cos(9 * x1)
 
 
-def branin(x0: float, x1: float) -> float:
-    a, b = 15 * x0 - 5, 15 * x1
-    return ((b - 5.1 / (4 * math.pi ** 2) * a ** 2 + 5 / math.pi * a - 6) ** 2
-            + 10 * (1 - 1 / (8 * math.pi)) * math.cos(a) + 10) / 100
-
-
 REGIONS = {  # name: (objective, fails)
     "edge": (objective, inside),
-    "branin": (branin, lambda x0, x1: x0 > 0.5 and x1 < 0.5),
+    "branin": (lambda x0, x1: float(branin(x0, x1)) / 100, lambda x0, x1: x0 > 0.5 and x1 < 0.5),
     "holds-optimum": (lambda x0, x1: (x0 - 0.65) ** 2 + (x1 - 0.7) ** 2, inside),
 }
 DEEP = 0.03

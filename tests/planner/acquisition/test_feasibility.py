@@ -7,6 +7,7 @@ import torch
 
 from gryffin_ros.planner import Planner, load_config
 from gryffin_ros.planner.acquisition.feasibility import FeasibilityModel, combine
+from tests.conftest import branin
 
 SQUARE = {"parameters": [{"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0},
                          {"name": "x1", "type": "continuous", "low": 0.0, "high": 1.0}],
@@ -77,22 +78,32 @@ def test_every_feasibility_approach_proposes_feasible_points(approach):
         planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
 
 
+def share_inside(seed, fails, objective, counted_from=0, experiments=60):
+    """Run a campaign of `experiments` on the unit square where `fails(x0, x1)` experiments fail (reported as None,
+    the planner not told) and the others give `objective(x0, x1)`; the share of experiments `counted_from` + 1 ..
+    `experiments` that went inside the failing region."""
+    planner = Planner(SQUARE, seed=seed)
+    inside = 0
+    for experiment in range(experiments):
+        (proposal,) = planner.ask()
+        x0, x1 = proposal.params["x0"], proposal.params["x1"]
+        failed = fails(x0, x1)
+        inside += failed and experiment >= counted_from
+        planner.tell({**proposal.params, "y": None if failed else float(objective(x0, x1)),
+                      "experiment_id": proposal.experiment_id})
+    return inside / (experiments - counted_from)
+
+
 @pytest.mark.slow
 def test_a_region_that_always_fails_is_learned_and_avoided():
     """x0 > 0.5 and x1 > 0.5 fails (a quarter of the domain); the planner is not told. Over 60 experiments it must
     propose there far less often than the region's area (uniform sampling: 25 %; measured: about 5 %)."""
-    def run(seed):
-        planner = Planner(SQUARE, seed=seed)
-        inside = 0
-        for _ in range(60):
-            (proposal,) = planner.ask()
-            x0, x1 = proposal.params["x0"], proposal.params["x1"]
-            failed = x0 > 0.5 and x1 > 0.5
-            inside += failed
-            y = None if failed else (x0 - 0.25) ** 2 + (x1 - 0.3) ** 2 + 0.05 * np.sin(20 * x0)
-            planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
-        return inside / 60
-    assert np.mean([run(seed) for seed in (0, 1)]) < 0.125
+    def fails(x0, x1):
+        return x0 > 0.5 and x1 > 0.5
+
+    def objective(x0, x1):
+        return (x0 - 0.25) ** 2 + (x1 - 0.3) ** 2 + 0.05 * np.sin(20 * x0)
+    assert np.mean([share_inside(seed, fails, objective) for seed in (0, 1)]) < 0.125
 
 
 @pytest.mark.slow
@@ -102,19 +113,6 @@ def test_a_failing_quarter_that_holds_the_trend_s_best_is_left_once_learned():
     default must still send fewer of experiments 31-60 inside than uniform sampling would (25 %). Measured on these
     seeds: 4, 5 and 0 of 30 (before failures were believed at the incumbent and fwt's weight was raised to
     FEASIBILITY_POWER: 26, 21 and 10)."""
-    def branin(x0, x1):
-        a, b = 15 * x0 - 5, 15 * x1
-        return (b - 5.1 / (4 * np.pi ** 2) * a ** 2 + 5 / np.pi * a - 6) ** 2 + 10 * (1 - 1 / (8 * np.pi)) * np.cos(a)
-
-    def late_inside(seed):
-        planner = Planner(SQUARE, seed=seed)
-        inside = 0
-        for experiment in range(60):
-            (proposal,) = planner.ask()
-            x0, x1 = proposal.params["x0"], proposal.params["x1"]
-            failed = x0 > 0.5 and x1 < 0.5
-            inside += failed and experiment >= 30
-            planner.tell({**proposal.params, "y": None if failed else float(branin(x0, x1)),
-                          "experiment_id": proposal.experiment_id})
-        return inside / 30
-    assert np.mean([late_inside(seed) for seed in (0, 1, 2)]) < 0.25
+    def fails(x0, x1):
+        return x0 > 0.5 and x1 < 0.5
+    assert np.mean([share_inside(seed, fails, branin, counted_from=30) for seed in (0, 1, 2)]) < 0.25
