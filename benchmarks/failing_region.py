@@ -9,8 +9,10 @@ Regions (--region):
   three minima inside; the third, (0.124, 0.818), is the best feasible point.
 - holds-optimum: (x0 - 0.65)^2 + (x1 - 0.7)^2 with the quarter x0 > 0.5 and x1 > 0.5 failing: the unconstrained
   optimum inside, the best feasible points on the region's edge (where about half of any probes fail).
+- camel: the six-hump camel (x0 on [-3, 3], x1 on [-2, 2]) with the quarter x0 > 0.5 and x1 < 0.5 failing: one of
+  its two global minima inside, 0.015 from the region's edge; the other, (0.485, 0.678), feasible.
 
-    python -m benchmarks.failing_region [--seeds 5] [--region edge|branin|holds-optimum] [--feas-model kde|gp]
+    python -m benchmarks.failing_region [--seeds 5] [--region edge|branin|holds-optimum|camel] [--feas-model kde|gp]
                                         [--surrogate kde|gp|auto|portfolio] [--feas-approach fwt|fwa|fia|fca]
 """
 
@@ -36,10 +38,18 @@ def objective(x0: float, x1: float) -> float:
     return (x0 - 0.45) ** 2 + (x1 - 0.6) ** 2 + 0.02 * math.sin(12 * x0) * math.cos(9 * x1)
 
 
+def six_hump_camel(x0: float, x1: float) -> float:
+    """The six-hump camel on the unit square (x0 -> [-3, 3], x1 -> [-2, 2]): minima -1.0316 at (0.485, 0.678) and
+    (0.515, 0.322), four local ones around them."""
+    x, y = 6 * x0 - 3, 4 * x1 - 2
+    return (4 - 2.1 * x * x + x ** 4 / 3) * x * x + x * y + (4 * y * y - 4) * y * y
+
+
 REGIONS = {  # name: (objective, fails)
     "edge": (objective, inside),
     "branin": (lambda x0, x1: float(branin(x0, x1)) / 100, lambda x0, x1: x0 > 0.5 and x1 < 0.5),
     "holds-optimum": (lambda x0, x1: (x0 - 0.65) ** 2 + (x1 - 0.7) ** 2, inside),
+    "camel": (six_hump_camel, lambda x0, x1: x0 > 0.5 and x1 < 0.5),
 }
 DEEP = 0.03
 
