@@ -11,7 +11,7 @@ CAMEL_MINIMUM = -1.031628  # the six-hump camel's global minimum, at (+-0.0898, 
 def test_the_camel_region_holds_one_global_minimum_and_leaves_the_other_feasible():
     f, fails = REGIONS["camel"]
     inside, outside = ((0.0898 + 3) / 6, (-0.7126 + 2) / 4), ((-0.0898 + 3) / 6, (0.7126 + 2) / 4)
-    # the minimum's coordinates are printed to 4 digits: the value is within 1e-6 of the minimum there
+    # the minimum's coordinates, printed to 4 digits, give a value within 1e-6 of it (1e-5 allowed)
     assert f(*inside) == pytest.approx(CAMEL_MINIMUM, abs=1e-5) and fails(*inside)
     assert f(*outside) == pytest.approx(CAMEL_MINIMUM, abs=1e-5) and not fails(*outside)
     assert six_hump_camel(0.5, 0.5) == 0.0  # the origin of its own coordinates

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 import torch
 
+from benchmarks.failing_region import deep
 from gryffin_ros.planner import Planner, load_config
 from gryffin_ros.planner.acquisition.feasibility import FeasibilityModel, combine
 from tests.conftest import branin
@@ -78,19 +79,17 @@ def test_every_feasibility_approach_proposes_feasible_points(approach):
         planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
 
 
-def share_inside(seed, fails, objective, counted_from=0, experiments=60, deep=0.0):
+def share_inside(seed, fails, objective, counted_from=0, experiments=60, counts=None):
     """Run a campaign of `experiments` on the unit square where `fails(x0, x1)` experiments fail (reported as None,
     the planner not told) and the others give `objective(x0, x1)`; the share of experiments `counted_from` + 1 ..
-    `experiments` that went inside the failing region (with `deep` > 0: so far inside that the points `deep` away
-    along both axes and diagonals fail too)."""
+    `experiments` that went inside the failing region (or, given `counts(x0, x1)`, that it holds)."""
     planner = Planner(SQUARE, seed=seed)
     inside = 0
     for experiment in range(experiments):
         (proposal,) = planner.ask()
         x0, x1 = proposal.params["x0"], proposal.params["x1"]
         failed = fails(x0, x1)
-        counted = all(fails(x0 + a * deep, x1 + b * deep) for a in (-1, 0, 1) for b in (-1, 0, 1))
-        inside += counted and experiment >= counted_from
+        inside += (failed if counts is None else counts(x0, x1)) and experiment >= counted_from
         planner.tell({**proposal.params, "y": None if failed else float(objective(x0, x1)),
                       "experiment_id": proposal.experiment_id})
     return inside / (experiments - counted_from)
@@ -124,12 +123,16 @@ def test_a_failing_quarter_that_holds_the_trend_s_best_is_left_once_learned():
 def test_a_failing_quarter_that_holds_the_unconstrained_optimum_is_probed_at_its_edge_not_deep_inside():
     """(x0 - 0.65)^2 + (x1 - 0.7)^2 with the quarter x0 > 0.5, x1 > 0.5 failing: the best feasible points lie on the
     quarter's edge, where about half of any probes fail, and nothing is gained deep inside. Of experiments 31-60, those
-    deep inside (0.03 from the edge or more; uniform sampling: about 22 %) must stay few. Measured on these seeds: 1
-    and 0 of 30 (before fwt's compressed tail of -log EI, EI_TAIL_SLOPE: 17 and 19, the GP's negligible EI there,
-    among failures believed at the incumbent, outweighing P(feasible) ~ 0.1)."""
+    deep inside (benchmarks.failing_region.deep: 0.03 from the edge or more; uniform sampling: about 22 %) must stay
+    few. Measured on these seeds: 1 and 0 of 30 (before fwt's compressed tail of -log EI, EI_TAIL_SLOPE: 17 and 19,
+    the GP's negligible EI there, among failures believed at the incumbent, outweighing P(feasible) ~ 0.1)."""
     def fails(x0, x1):
         return x0 > 0.5 and x1 > 0.5
 
     def objective(x0, x1):
         return (x0 - 0.65) ** 2 + (x1 - 0.7) ** 2
-    assert np.mean([share_inside(seed, fails, objective, counted_from=30, deep=0.03) for seed in (0, 1)]) < 0.1
+
+    def deep_inside(x0, x1):
+        return deep(fails, x0, x1)
+    assert np.mean([share_inside(seed, fails, objective, counted_from=30, counts=deep_inside)
+                    for seed in (0, 1)]) < 0.1
