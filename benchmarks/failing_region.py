@@ -12,8 +12,12 @@ Regions (--region):
 - camel: the six-hump camel (x0 on [-3, 3], x1 on [-2, 2]) with the quarter x0 > 0.5 and x1 < 0.5 failing: one of
   its two global minima inside, 0.015 from the region's edge; the other, (0.485, 0.678), feasible.
 
+With --dims D > 2 the square becomes the unit cube of D dims: the region fails by x0 and x1 alone (a slab), and
+each further coordinate adds EXTRA_WEIGHT (x_i - EXTRA_CENTRE)^2 to the objective, so the optimum's value stays.
+
     python -m benchmarks.failing_region [--seeds 5] [--region edge|branin|holds-optimum|camel] [--feas-model kde|gp]
                                         [--surrogate kde|gp|auto|portfolio] [--feas-approach fwt|fwa|fia|fca]
+                                        [--dims 2]
 """
 
 from __future__ import annotations
@@ -25,8 +29,13 @@ import statistics
 from benchmarks.surfaces import branin
 
 EXPERIMENTS, LATE = 60, 30
-SQUARE = {"parameters": [{"name": n, "type": "continuous", "low": 0.0, "high": 1.0} for n in ("x0", "x1")],
-          "objectives": [{"name": "y", "goal": "min"}]}
+EXTRA_WEIGHT, EXTRA_CENTRE = 0.5, 0.4
+
+
+def cube(dims: int = 2) -> dict:
+    """The planner's config: `dims` continuous parameters x0, x1, ... on [0, 1], one objective to minimize."""
+    return {"parameters": [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(dims)],
+            "objectives": [{"name": "y", "goal": "min"}]}
 
 
 def inside(x0: float, x1: float) -> bool:
@@ -68,14 +77,14 @@ def best_feasible(region: str = "edge", steps: int = 1001) -> float:
     return float(values[~np.vectorize(fails)(x0, x1)].min())
 
 
-def run(seed: int, general: dict, region: str = "edge") -> tuple[int, int, float]:
+def run(seed: int, general: dict, region: str = "edge", dims: int = 2) -> tuple[int, int, float]:
     """-> (experiments LATE + 1 .. EXPERIMENTS inside the failing region, those deep inside, best result)."""
     import torch
 
     from gryffin_ros.planner import Planner
     torch.set_num_threads(1)
     f, fails = REGIONS[region]
-    planner = Planner({**SQUARE, "general": general}, seed=seed)
+    planner = Planner({**cube(dims), "general": general}, seed=seed)
     late, late_deep, best = 0, 0, math.inf
     for experiment in range(1, EXPERIMENTS + 1):
         (proposal,) = planner.ask()
@@ -83,9 +92,9 @@ def run(seed: int, general: dict, region: str = "edge") -> tuple[int, int, float
         failed = fails(x0, x1)
         late += failed and experiment > LATE
         late_deep += deep(fails, x0, x1) and experiment > LATE
-        best = best if failed else min(best, f(x0, x1))
-        planner.tell({**proposal.params, "y": None if failed else f(x0, x1),
-                      "experiment_id": proposal.experiment_id})
+        y = f(x0, x1) + EXTRA_WEIGHT * sum((proposal.params[f"x{i}"] - EXTRA_CENTRE) ** 2 for i in range(2, dims))
+        best = best if failed else min(best, y)
+        planner.tell({**proposal.params, "y": None if failed else y, "experiment_id": proposal.experiment_id})
     return late, late_deep, best
 
 
@@ -96,13 +105,16 @@ def main() -> None:
     parser.add_argument("--feas-model", default=None, help="general.feas_model (default: the planner's)")
     parser.add_argument("--surrogate", default=None, help="general.surrogate (default: the planner's)")
     parser.add_argument("--feas-approach", default=None, help="general.feas_approach (default: the planner's)")
+    parser.add_argument("--dims", type=int, default=2, help="continuous parameters (>= 2; see above)")
     args = parser.parse_args()
+    if args.dims < 2:
+        parser.error("--dims must be at least 2: the regions are defined on x0 and x1")
     general = {k: v for k, v in (("feas_model", args.feas_model), ("surrogate", args.surrogate),
                                  ("feas_approach", args.feas_approach)) if v is not None}
     optimum = best_feasible(args.region)
     counts, deeps, regrets = [], [], []
     for seed in range(args.seeds):
-        count, count_deep, best = run(seed, general, args.region)
+        count, count_deep, best = run(seed, general, args.region, args.dims)
         counts.append(count)
         deeps.append(count_deep)
         regrets.append(best - optimum)
@@ -111,7 +123,8 @@ def main() -> None:
     share = [100.0 * c / (EXPERIMENTS - LATE) for c in counts]
     share_deep = [100.0 * c / (EXPERIMENTS - LATE) for c in deeps]
     se = statistics.stdev(share) / math.sqrt(len(share)) if len(share) > 1 else float("nan")
-    print(f"{args.region}, {general or 'default'}: {statistics.mean(share):.1f} ± {se:.1f} % of experiments "
+    print(f"{args.region}{f' in {args.dims}-D' if args.dims > 2 else ''}, {general or 'default'}: "
+          f"{statistics.mean(share):.1f} ± {se:.1f} % of experiments "
           f"{LATE + 1}-{EXPERIMENTS} inside the failing region ({statistics.mean(share_deep):.1f} % deep inside), "
           f"{args.seeds} seeds; regret (best - {optimum:.5f}) median {statistics.median(regrets):.2e}, "
           f"worst {max(regrets):.2e}")
