@@ -499,33 +499,49 @@ def test_hyperparameters_are_fitted_to_the_best_and_a_seeded_draw_of_the_rest_be
     assert not np.array_equal(subset, fit_subset(y, seed=2))
 
 
+class FixedAcquisition:
+    """An acquisition whose values at the candidates are given: -log EI (log_scale) or the kernel acquisition."""
+
+    def __init__(self, values, log_scale=True):
+        self.values, self.log_scale = np.array(values), log_scale
+
+    def evaluate(self, X):
+        return self.values
+
+
+class FixedFeasibility:
+    """A failure model whose P(feasible) at the candidates is given."""
+    fraction_failed = 0.5
+
+    def __init__(self, p):
+        self.p = np.array(p)
+
+    def probability(self, X):
+        return self.p
+
+
+def scores(approach, values, p, log_scale=True):
+    """The planner's scores of three candidates with the given acquisition values and P(feasible) (exhaustive: as
+    they are, no optimization)."""
+    planner = Planner(config("gp", feas_approach=approach), seed=0)
+    candidates = np.array([[0.1, 0.1], [0.5, 0.5], [0.9, 0.9]])
+    _, alpha = planner._candidates(FixedAcquisition(values, log_scale), candidates, True, None,
+                                   np.random.default_rng(0), FixedFeasibility(p))
+    return alpha
+
+
 def test_with_failures_the_gp_weights_expected_improvement_by_the_probability_of_success():
     """fwa with the GP: -log EI - log P (constrained EI), so halving P(feasible) costs log 2 whatever EI is; fwt (the
     default): -log EI, its tail beyond EI_FLOOR_NATS compressed by EI_TAIL_SLOPE, - FEASIBILITY_POWER log min(1, P /
     0.5); the kernel acquisition keeps Gryffin's rescaled -(1 - a) P."""
     from gryffin_ros.planner.strategies.gryffin import EI_FLOOR_NATS, EI_TAIL_SLOPE, FEASIBILITY_POWER
-    class Acquisition:
-        def __init__(self, log_scale):
-            self.log_scale = log_scale
-
-        def evaluate(self, X):
-            return np.array([3.0, 1.0, 7.0])  # -log EI
-
-    class Feasibility:
-        fraction_failed = 0.5
-
-        def probability(self, X):
-            return np.array([0.5, 0.25, 1.0])
-
-    planner = Planner(config("gp", feas_approach="fwa"), seed=0)
-    start = np.array([[0.1, 0.1], [0.5, 0.5], [0.9, 0.9]])
-    _, alpha = planner._candidates(Acquisition(True), start, True, None, np.random.default_rng(0), Feasibility())
+    values, p = [3.0, 1.0, 7.0], [0.5, 0.25, 1.0]
+    alpha = scores("fwa", values, p)
     np.testing.assert_allclose(alpha, [3.0 + np.log(2), 1.0 + np.log(4), 7.0], rtol=1e-12)
-    _, alpha = planner._candidates(Acquisition(False), start, True, None, np.random.default_rng(0), Feasibility())
+    alpha = scores("fwa", values, p, log_scale=False)
     np.testing.assert_allclose(alpha, [-(1 - 1 / 3) * 0.5, -1.0 * 0.25, 0.0], rtol=1e-12)
-    planner = Planner(config("gp"), seed=0)
-    assert planner.config.general.feas_approach == "fwt" and FEASIBILITY_POWER > 1
-    _, alpha = planner._candidates(Acquisition(True), start, True, None, np.random.default_rng(0), Feasibility())
+    assert Planner(config("gp"), seed=0).config.general.feas_approach == "fwt" and FEASIBILITY_POWER > 1
+    alpha = scores("fwt", values, p)
     assert 3.0 < EI_FLOOR_NATS < 7.0 and 0 < EI_TAIL_SLOPE < 1
     tail = EI_FLOOR_NATS + EI_TAIL_SLOPE * (7.0 - EI_FLOOR_NATS)
     np.testing.assert_allclose(alpha, [3.0, 1.0 + FEASIBILITY_POWER * np.log(2), tail], rtol=1e-12)
@@ -537,38 +553,12 @@ def test_with_failures_a_negligible_expected_improvement_does_not_outweigh_the_r
     EI, and fwt before it) the first wins. A substantial EI (e^-1) at P = 0.3 still beats e^-20 at P = 1; among likely
     feasible candidates the order stays EI's, and in the tail too: an untried option at e^-200 and P = 0.3 still
     beats one at e^-2000 and P = 1 (a flat floor on EI ranked those by P alone)."""
-    class Acquisition:
-        log_scale = True
-
-        def __init__(self, values):
-            self.values = np.array(values)
-
-        def evaluate(self, X):
-            return self.values  # -log EI
-
-    class Feasibility:
-        fraction_failed = 0.3
-
-        def __init__(self, p):
-            self.p = np.array(p)
-
-        def probability(self, X):
-            return self.p
-
-    start = np.array([[0.1, 0.1], [0.5, 0.5], [0.9, 0.9]])
-    rng = np.random.default_rng(0)
-
-    def best(approach, values, p):
-        planner = Planner(config("gp", feas_approach=approach), seed=0)
-        _, alpha = planner._candidates(Acquisition(values), start, True, None, rng, Feasibility(p))
-        return int(np.argmin(alpha)), alpha
-
-    assert best("fwt", [6.0, 20.0, 30.0], [0.1, 1.0, 1.0])[0] == 1
-    assert best("fwa", [6.0, 20.0, 30.0], [0.1, 1.0, 1.0])[0] == 0
-    assert best("fwt", [1.0, 20.0, 30.0], [0.3, 1.0, 1.0])[0] == 0
-    _, alpha = best("fwt", [6.0, 20.0, 30.0], [0.1, 1.0, 1.0])
+    alpha = scores("fwt", [6.0, 20.0, 30.0], [0.1, 1.0, 1.0])
+    assert int(np.argmin(alpha)) == 1
     assert alpha[1] < alpha[2]  # 20 and 30 nats: both in the tail, still in EI's order
-    assert best("fwt", [200.0, 2000.0, 3000.0], [0.3, 1.0, 1.0])[0] == 0
+    assert int(np.argmin(scores("fwa", [6.0, 20.0, 30.0], [0.1, 1.0, 1.0]))) == 0
+    assert int(np.argmin(scores("fwt", [1.0, 20.0, 30.0], [0.3, 1.0, 1.0]))) == 0
+    assert int(np.argmin(scores("fwt", [200.0, 2000.0, 3000.0], [0.3, 1.0, 1.0]))) == 0
 
 
 def test_a_failed_experiment_is_believed_no_better_than_the_incumbent():

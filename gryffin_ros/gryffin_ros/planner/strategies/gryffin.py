@@ -301,8 +301,9 @@ class Planner(BasePlanner):
                 # P / FWT_THRESHOLD up to 1, to the power FEASIBILITY_POWER, -log EI's tail beyond EI_FLOOR_NATS
                 # compressed, in log space: its min-max rescaled value is nearly flat where EI is small, and failing
                 # regions kept their weight
-                power = FEASIBILITY_POWER if general.feas_approach == "fwt" else 1.0
+                power = 1.0
                 if general.feas_approach == "fwt":
+                    power = FEASIBILITY_POWER
                     alpha = np.where(alpha > EI_FLOOR_NATS, EI_FLOOR_NATS + EI_TAIL_SLOPE * (alpha - EI_FLOOR_NATS),
                                      alpha)
                 alpha = alpha - power * np.log(np.maximum(weight(probability, general.feas_approach), MIN_PROBABILITY))
