@@ -510,37 +510,30 @@ class FixedAcquisition:
 
 
 class FixedFeasibility:
-    """A failure model whose P(feasible) and novelty (the wide estimate's share of P; 0: beside experiments) at the
-    candidates are given."""
+    """A failure model whose P(feasible) at the candidates is given."""
     fraction_failed = 0.5
 
-    def __init__(self, p, novelty=None):
+    def __init__(self, p):
         self.p = np.array(p)
-        self.novelty = np.zeros(len(self.p)) if novelty is None else np.array(novelty)
 
     def probability(self, X):
         return self.p
 
-    def probability_and_novelty(self, X):
-        return self.p, self.novelty
 
-
-def scores(approach, values, p, log_scale=True, novelty=None):
+def scores(approach, values, p, log_scale=True):
     """The planner's scores of three candidates with the given acquisition values and P(feasible) (exhaustive: as
     they are, no optimization)."""
     planner = Planner(config("gp", feas_approach=approach), seed=0)
     candidates = np.array([[0.1, 0.1], [0.5, 0.5], [0.9, 0.9]])
     _, alpha = planner._candidates(FixedAcquisition(values, log_scale), candidates, True, None,
-                                   np.random.default_rng(0), FixedFeasibility(p, novelty))
+                                   np.random.default_rng(0), FixedFeasibility(p))
     return alpha
 
 
 def test_with_failures_the_gp_weights_expected_improvement_by_the_probability_of_success():
     """fwa with the GP: -log EI - log P (constrained EI), so halving P(feasible) costs log 2 whatever EI is; fwt (the
     default): -log EI, its tail beyond EI_FLOOR_NATS compressed by EI_TAIL_SLOPE, - FEASIBILITY_POWER log min(1, P /
-    threshold), the threshold 0.5 beside experiments and rising with the novelty to FWT_UNSEEN_THRESHOLD where none is
-    near; the kernel acquisition keeps Gryffin's rescaled -(1 - a) P."""
-    from gryffin_ros.planner.acquisition.feasibility import FWT_THRESHOLD, FWT_UNSEEN_THRESHOLD
+    0.5); the kernel acquisition keeps Gryffin's rescaled -(1 - a) P."""
     from gryffin_ros.planner.strategies.gryffin import EI_FLOOR_NATS, EI_TAIL_SLOPE, FEASIBILITY_POWER
     values, p = [3.0, 1.0, 7.0], [0.5, 0.25, 1.0]
     alpha = scores("fwa", values, p)
@@ -552,11 +545,6 @@ def test_with_failures_the_gp_weights_expected_improvement_by_the_probability_of
     assert 3.0 < EI_FLOOR_NATS < 7.0 and 0 < EI_TAIL_SLOPE < 1
     tail = EI_FLOOR_NATS + EI_TAIL_SLOPE * (7.0 - EI_FLOOR_NATS)
     np.testing.assert_allclose(alpha, [3.0, 1.0 + FEASIBILITY_POWER * np.log(2), tail], rtol=1e-12)
-    assert FWT_THRESHOLD == 0.5 < FWT_UNSEEN_THRESHOLD < 1.0
-    alpha = scores("fwt", values, p, novelty=[1.0, 0.5, 1.0])  # P = 0.5 no longer enough where no experiment is near
-    halfway = (FWT_THRESHOLD + FWT_UNSEEN_THRESHOLD) / 2
-    np.testing.assert_allclose(alpha, [3.0 + FEASIBILITY_POWER * np.log(FWT_UNSEEN_THRESHOLD / 0.5),
-                                       1.0 + FEASIBILITY_POWER * np.log(halfway / 0.25), tail], rtol=1e-12)
 
 
 def test_with_failures_a_negligible_expected_improvement_does_not_outweigh_the_risk_of_failing():

@@ -30,24 +30,12 @@ FCA_MIN_PASSING = 0.1
 # them; fca's hard cut (P > 0.5 only) kept a cell whose options all failed elsewhere out until almost every other one
 # was tried (Michalewicz without descriptors: 2 of 30 seeds at 440 of 441). benchmarks/README.md, round four.
 FWT_THRESHOLD = 0.5
-# ... where no experiment is near (P is the wide estimate alone), the threshold rises towards FWT_UNSEEN_THRESHOLD, in
-# the GP's score (which passes the novelty to `weight`). The wide kernels, as broad as the spacing of the data, blur a
-# failing region's sharp edge with the successes beside it: deep inside a failing quarter of the square, 0.03 to 0.2
-# from its edge and away from its failed points, they gave P = 0.55-0.86, fwt's full weight, and the GP's expected
-# improvement there (the six-hump camel's second minimum) drew 11 % of experiments 31-60 inside; 6.0 % with 0.9, and
-# 1.2 % instead of 5.4 % deep inside a failing quarter that holds the unconstrained optimum (benchmarks/README.md,
-# round twelve). Beside observations the narrow kernels decide P and the threshold stays FWT_THRESHOLD.
-FWT_UNSEEN_THRESHOLD = 0.9
 
 
-def weight(p_feasible: np.ndarray, approach: str, novelty: np.ndarray | None = None) -> np.ndarray:
-    """The factor fwa and fwt weigh the acquisition by: P itself (fwa), or P / threshold up to 1 (fwt), the threshold
-    FWT_THRESHOLD, or with `novelty` (`FeasibilityModel.probability_and_novelty`) FWT_THRESHOLD + (FWT_UNSEEN_THRESHOLD
-    - FWT_THRESHOLD) * novelty."""
+def weight(p_feasible: np.ndarray, approach: str) -> np.ndarray:
+    """The factor fwa and fwt weigh the acquisition by: P itself (fwa), or P / FWT_THRESHOLD up to 1 (fwt)."""
     if approach == "fwt":
-        threshold = FWT_THRESHOLD if novelty is None else \
-            FWT_THRESHOLD + (FWT_UNSEEN_THRESHOLD - FWT_THRESHOLD) * np.clip(novelty, 0.0, 1.0)
-        return np.minimum(1.0, p_feasible / threshold)
+        return np.minimum(1.0, p_feasible / FWT_THRESHOLD)
     return p_feasible
 
 
@@ -91,15 +79,9 @@ class FeasibilityModel:
         wide estimate (kernels as wide as the data spacing, descriptors shared, or the GP classifier) as their
         prior instead of a constant: near observations the narrow kernels decide, elsewhere the prior extends what was
         seen."""
-        return self.probability_and_novelty(X)[0]
-
-    def probability_and_novelty(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(M, D) internal points -> P(feasible) and the novelty u / (S + u), the wide estimate's share of P: 0 where
-        the narrow kernels of observations dominate, 1 where none reaches (P is the wide estimate alone)."""
         prior = self._wide.probability(X)
         alpha0, alpha1 = (a.evaluate(X) for a in self._narrow)  # S_fail/(S+u) and (S_fail+u)/(S+u)
-        novelty = alpha1 - alpha0
-        return 1.0 - alpha0 - (1.0 - prior) * novelty, novelty
+        return 1.0 - alpha0 - (1.0 - prior) * (alpha1 - alpha0)
 
 
 def combine(alpha: np.ndarray, p_feasible: np.ndarray, approach: str, feas_param: float,

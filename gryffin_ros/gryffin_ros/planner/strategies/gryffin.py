@@ -295,11 +295,10 @@ class Planner(BasePlanner):
             candidates, alpha = candidates[keep], alpha[keep]
         if feasibility is not None:
             general = self.config.general
-            probability, novelty = feasibility.probability_and_novelty(candidates)
+            probability = feasibility.probability(candidates)
             if general.feas_approach in ("fwa", "fwt") and acquisition.log_scale:
                 # the GP's EI weighted by P(feasible) itself (fwa: constrained EI, Gardner et al. 2014) or (fwt) by
-                # P / threshold up to 1 (FWT_THRESHOLD beside experiments, up to FWT_UNSEEN_THRESHOLD away from
-                # them), to the power FEASIBILITY_POWER, -log EI's tail beyond EI_FLOOR_NATS
+                # P / FWT_THRESHOLD up to 1, to the power FEASIBILITY_POWER, -log EI's tail beyond EI_FLOOR_NATS
                 # compressed, in log space: its min-max rescaled value is nearly flat where EI is small, and failing
                 # regions kept their weight
                 power = 1.0
@@ -307,8 +306,7 @@ class Planner(BasePlanner):
                     power = FEASIBILITY_POWER
                     alpha = np.where(alpha > EI_FLOOR_NATS, EI_FLOOR_NATS + EI_TAIL_SLOPE * (alpha - EI_FLOOR_NATS),
                                      alpha)
-                factor = weight(probability, general.feas_approach, novelty)
-                alpha = alpha - power * np.log(np.maximum(factor, MIN_PROBABILITY))
+                alpha = alpha - power * np.log(np.maximum(weight(probability, general.feas_approach), MIN_PROBABILITY))
             else:
                 alpha = combine(alpha, probability, general.feas_approach, general.feas_param,
                                 feasibility.fraction_failed)
