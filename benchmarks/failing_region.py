@@ -11,13 +11,19 @@ Regions (--region):
   optimum inside, the best feasible points on the region's edge (where about half of any probes fail).
 - camel: the six-hump camel (x0 on [-3, 3], x1 on [-2, 2]) with the quarter x0 > 0.5 and x1 < 0.5 failing: one of
   its two global minima inside, 0.015 from the region's edge; the other, (0.485, 0.678), feasible.
+- camel-open: the six-hump camel with no failing region; with --failure-rate, failures at random only.
+
+With --failure-rate R every experiment also fails with probability R wherever it is (an instrument's random failures;
+drawn from a generator seeded by the run's seed, the same draws whatever the planner proposes). The last line then
+also counts the runs that ended STUCK_REGRET or more short of the best feasible value (on the camel: on one of its
+local minima, -0.2155, regret 0.82, instead of a global one).
 
 With --dims D > 2 the square becomes the unit cube of D dims: the region fails by x0 and x1 alone (a slab), and
 each further coordinate adds EXTRA_WEIGHT (x_i - EXTRA_CENTRE)^2 to the objective, so the optimum's value stays.
 
-    python -m benchmarks.failing_region [--seeds 5] [--region edge|branin|holds-optimum|camel] [--feas-model kde|gp]
-                                        [--surrogate kde|gp|auto|portfolio] [--feas-approach fwt|fwa|fia|fca]
-                                        [--dims 2]
+    python -m benchmarks.failing_region [--seeds 5] [--region edge|branin|holds-optimum|camel|camel-open]
+                                        [--feas-model kde|gp] [--surrogate kde|gp|auto|portfolio]
+                                        [--feas-approach fwt|fwa|fia|fca] [--dims 2] [--failure-rate 0]
 """
 
 from __future__ import annotations
@@ -59,8 +65,11 @@ REGIONS = {  # name: (objective, fails)
     "branin": (lambda x0, x1: float(branin(x0, x1)) / 100, lambda x0, x1: x0 > 0.5 and x1 < 0.5),
     "holds-optimum": (lambda x0, x1: (x0 - 0.65) ** 2 + (x1 - 0.7) ** 2, inside),
     "camel": (six_hump_camel, lambda x0, x1: x0 > 0.5 and x1 < 0.5),
+    "camel-open": (six_hump_camel, lambda x0, x1: False),
 }
 DEEP = 0.03
+STUCK_REGRET = 0.5
+RANDOM_FAILURE_SEED = 1000  # + the run's seed: the generator of --failure-rate's draws
 
 
 def deep(fails, x0: float, x1: float) -> bool:
@@ -77,20 +86,29 @@ def best_feasible(region: str = "edge", steps: int = 1001) -> float:
     return float(values[~np.vectorize(fails)(x0, x1)].min())
 
 
-def run(seed: int, general: dict, region: str = "edge", dims: int = 2) -> tuple[int, int, float]:
-    """-> (experiments LATE + 1 .. EXPERIMENTS inside the failing region, those deep inside, best result)."""
+def failure_draws(seed: int, rate: float, experiments: int = EXPERIMENTS) -> list[bool]:
+    """Which of a run's experiments fail at random (--failure-rate), whatever and wherever they are."""
+    import numpy as np
+    return (np.random.default_rng(RANDOM_FAILURE_SEED + seed).random(experiments) < rate).tolist()
+
+
+def run(seed: int, general: dict, region: str = "edge", dims: int = 2, failure_rate: float = 0.0
+        ) -> tuple[int, int, float]:
+    """-> (experiments LATE + 1 .. EXPERIMENTS inside the failing region, those deep inside, best result); with
+    failure_rate each experiment also fails with that probability, wherever it is."""
     import torch
 
     from gryffin_ros.planner import Planner
     torch.set_num_threads(1)
     f, fails = REGIONS[region]
     planner = Planner({**cube(dims), "general": general}, seed=seed)
+    randomly = failure_draws(seed, failure_rate)
     late, late_deep, best = 0, 0, math.inf
     for experiment in range(1, EXPERIMENTS + 1):
         (proposal,) = planner.ask()
         x0, x1 = proposal.params["x0"], proposal.params["x1"]
-        failed = fails(x0, x1)
-        late += failed and experiment > LATE
+        late += fails(x0, x1) and experiment > LATE
+        failed = fails(x0, x1) or randomly[experiment - 1]
         late_deep += deep(fails, x0, x1) and experiment > LATE
         y = f(x0, x1) + EXTRA_WEIGHT * sum((proposal.params[f"x{i}"] - EXTRA_CENTRE) ** 2 for i in range(2, dims))
         best = best if failed else min(best, y)
@@ -106,15 +124,18 @@ def main() -> None:
     parser.add_argument("--surrogate", default=None, help="general.surrogate (default: the planner's)")
     parser.add_argument("--feas-approach", default=None, help="general.feas_approach (default: the planner's)")
     parser.add_argument("--dims", type=int, default=2, help="continuous parameters (>= 2; see above)")
+    parser.add_argument("--failure-rate", type=float, default=0.0, help="random failures anywhere (see above)")
     args = parser.parse_args()
     if args.dims < 2:
         parser.error("--dims must be at least 2: the regions are defined on x0 and x1")
+    if not 0.0 <= args.failure_rate < 1.0:
+        parser.error("--failure-rate must be in [0, 1)")
     general = {k: v for k, v in (("feas_model", args.feas_model), ("surrogate", args.surrogate),
                                  ("feas_approach", args.feas_approach)) if v is not None}
     optimum = best_feasible(args.region)
     counts, deeps, regrets = [], [], []
     for seed in range(args.seeds):
-        count, count_deep, best = run(seed, general, args.region, args.dims)
+        count, count_deep, best = run(seed, general, args.region, args.dims, args.failure_rate)
         counts.append(count)
         deeps.append(count_deep)
         regrets.append(best - optimum)
@@ -127,7 +148,9 @@ def main() -> None:
           f"{statistics.mean(share):.1f} ± {se:.1f} % of experiments "
           f"{LATE + 1}-{EXPERIMENTS} inside the failing region ({statistics.mean(share_deep):.1f} % deep inside), "
           f"{args.seeds} seeds; regret (best - {optimum:.5f}) median {statistics.median(regrets):.2e}, "
-          f"worst {max(regrets):.2e}")
+          f"worst {max(regrets):.2e}"
+          + (f"; random failures {args.failure_rate:g}: {sum(r >= STUCK_REGRET for r in regrets)} of {args.seeds} "
+             f"runs {STUCK_REGRET:g} or more short" if args.failure_rate else ""))
 
 
 if __name__ == "__main__":
