@@ -112,7 +112,8 @@ def test_a_failing_quarter_that_holds_the_trend_s_best_is_left_once_learned():
     """Branin on the unit square with the quarter x0 > 0.5, x1 < 0.5 failing (two of its three minima inside; the
     planner is not told). The GP, fitted to the successes alone, keeps expecting large improvements in there; the
     default must still send fewer of experiments 31-60 inside than uniform sampling would (25 %). Measured on these
-    seeds: 1, 2 and 0 of 30 (before fwt's compressed tail of -log EI, EI_TAIL_SLOPE: 4, 5 and 0; before failures were
+    seeds: 1, 2 and 1 of 30 (with the wide estimate's prior worth one observation, not WIDE_PRIOR_WEIGHT: 1, 2 and 0;
+    before fwt's compressed tail of -log EI, EI_TAIL_SLOPE: 4, 5 and 0; before failures were
     believed at the incumbent and fwt's weight was raised to FEASIBILITY_POWER: 26, 21 and 10)."""
     def fails(x0, x1):
         return x0 > 0.5 and x1 < 0.5

@@ -90,6 +90,24 @@ def test_acquisition_limits_far_from_and_at_the_data():
     assert explore[0] > explore[2] and exploit[0] < exploit[2]
 
 
+def test_the_uniform_prior_counts_as_prior_weight_observations():
+    """alpha = (sum_k f_k p_k + s w u) / (sum_k p_k + w u): with w = 3 the prior pulls alpha towards s as three
+    observations spread over the space would; the failure model's wide estimate uses WIDE_PRIOR_WEIGHT."""
+    from gryffin_ros.planner.acquisition.feasibility import WIDE_PRIOR_WEIGHT
+    space = SearchSpace.from_config([{"name": "x", "type": "continuous", "low": 0, "high": 1}])
+    X = np.array([[0.3], [0.35]])
+    density = KernelDensity(space, X, np.array([0.0, 0.0]), 1.0, torch.Generator().manual_seed(0),
+                            spacing_scaled=True)
+    probes = np.array([[0.3], [0.5], [0.999]])
+    kernels = torch.exp(density.log_kernels(*split(space, probes))).sum(1).numpy()  # sum_k p_k, the uniform u = 1
+    for w in (1.0, 3.0):
+        alpha = Acquisition(density, 1.0, prior_weight=w).evaluate(probes)
+        # merits 0, s = 1; float64 sums of the same terms in another order (log space there): 1e-9 is far above that
+        np.testing.assert_allclose(alpha, w / (kernels + w), rtol=1e-9)
+    assert Acquisition(density, 1.0, 3.0).evaluate(probes)[1] > Acquisition(density, 1.0).evaluate(probes)[1]
+    assert WIDE_PRIOR_WEIGHT > 1
+
+
 def test_spacing_scaled_kernels_fill_the_gaps_between_observations():
     """Gryffin's 12 rho^2 kernels leave alpha = s (flat) between observations; the spacing-scaled kernels that
     general.kernel_width = auto/spacing uses interpolate there, so the acquisition ranks the gaps."""

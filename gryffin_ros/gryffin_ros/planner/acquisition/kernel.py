@@ -11,6 +11,8 @@ largest term; in high dimensions or with many observations that is a small minor
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import torch
 
@@ -24,16 +26,18 @@ CHUNK_ELEMENTS = 2_000_000
 class Acquisition:
     log_scale = False  # Gryffin's acquisition values, not a logarithm (AcquisitionFunction)
 
-    def __init__(self, density: KernelDensity, strategy: float):
+    def __init__(self, density: KernelDensity, strategy: float, prior_weight: float = 1.0):
+        """prior_weight: how many observations the uniform term 1/V counts as (Gryffin: one)."""
         self.density = density
         self.strategy = float(strategy)
+        self._log_uniform = density.log_uniform + math.log(prior_weight)
 
     def _alpha(self, log_p: torch.Tensor, shift: torch.Tensor) -> torch.Tensor:
         # terms below e^-(2 CUTOFF) of the largest are set to exactly 0: they are far below float64 resolution of the
         # result, and left alone they become subnormal numbers, which slow exp and matmul down by ~100x on x86
         relative = log_p - shift[:, None]
         weights = torch.where(relative > -2 * CUTOFF, torch.exp(relative.clamp_min(-2 * CUTOFF)), 0.0)
-        uniform = torch.exp(self.density.log_uniform - shift)
+        uniform = torch.exp(self._log_uniform - shift)
         return (weights @ self.density.merits + self.strategy * uniform) / (weights.sum(1) + uniform)
 
     def _chunk(self, xc: torch.Tensor, xf: torch.Tensor, with_grad: bool) -> tuple[torch.Tensor, torch.Tensor]:
@@ -44,7 +48,7 @@ class Acquisition:
         with torch.no_grad():
             dense = density.log_kernels(xc, xf)  # (M, N)
             largest = dense.amax(dim=1)
-            shift = torch.clamp_min(largest, density.log_uniform)
+            shift = torch.clamp_min(largest, self._log_uniform)
             # rows where some kernel is within CUTOFF of the largest term; elsewhere alpha = s and the gradient is 0
             live = torch.nonzero(largest > shift - CUTOFF).flatten()
             if not len(live):
