@@ -31,11 +31,12 @@ FCA_MIN_PASSING = 0.1
 # was tried (Michalewicz without descriptors: 2 of 30 seeds at 440 of 441). benchmarks/README.md, round four.
 FWT_THRESHOLD = 0.5
 # The wide estimate's prior counts as this many observations spread over the space (Gryffin's kernel acquisition: one).
-# With one, three failures among a campaign's first ten experiments (random ones: a blocked line, a cracked vial) made
-# their part of the space "failing" (wide P ~0.2-0.3, fwt's weight to the power 5 on the GP's EI costing 2-3 nats)
-# and a campaign that had found a local basin elsewhere never went back: the six-hump camel with 30 % of experiments
-# failing at random, 4 of 96 campaigns ended on a local minimum; 0 of 96 with three, the failing regions and the
-# paper's surfaces with unknown constraints within noise (benchmarks/README.md, round twelve).
+# With one, a few failures early in a campaign (random ones too: a blocked line, a cracked vial) lowered the wide P
+# across their part of the space, fwt's weight to the power 5 on the GP's EI kept the campaign out of it, and one that
+# had found a local basin elsewhere never went back: the six-hump camel with 30 % of experiments failing at random,
+# 4 of 96 campaigns ended on a local minimum (with P taken as 1, those four ended within 0.05 of the optimum); 0 of 96
+# with three, the failing regions and the paper's surfaces with unknown constraints within noise
+# (benchmarks/README.md, round twelve).
 WIDE_PRIOR_WEIGHT = 3.0
 
 
