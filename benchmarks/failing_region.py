@@ -107,8 +107,9 @@ def run(seed: int, general: dict, region: str = "edge", dims: int = 2, failure_r
     for experiment in range(1, EXPERIMENTS + 1):
         (proposal,) = planner.ask()
         x0, x1 = proposal.params["x0"], proposal.params["x1"]
-        late += fails(x0, x1) and experiment > LATE
-        failed = fails(x0, x1) or randomly[experiment - 1]
+        in_region = fails(x0, x1)
+        late += in_region and experiment > LATE
+        failed = in_region or randomly[experiment - 1]
         late_deep += deep(fails, x0, x1) and experiment > LATE
         y = f(x0, x1) + EXTRA_WEIGHT * sum((proposal.params[f"x{i}"] - EXTRA_CENTRE) ** 2 for i in range(2, dims))
         best = best if failed else min(best, y)
