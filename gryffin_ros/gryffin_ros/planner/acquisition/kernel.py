@@ -1,7 +1,8 @@
 """Gryffin's acquisition alpha(x) = (sum_k f_k p_k(x) + lambda) / (sum_k p_k(x) + 1/V), lambda = s/V, minimized.
 
 s in [-1, 1] is the sampling strategy: s = +1 favours points near good observations (exploitation), s = -1 points far
-from every observation (exploration). Evaluated in log space so narrow kernels never underflow.
+from every observation (exploration). The uniform term 1/V counts as one observation; `prior_weight` w makes it w/V
+(and lambda = s w/V). Evaluated in log space so narrow kernels never underflow.
 
 Kernels are narrow (precision 12 rho^2), so far from the data every kernel term underflows next to the uniform one:
 there alpha = s and its gradient is 0 to float64 resolution (each term is below e^-CUTOFF of the largest). The
