@@ -226,18 +226,21 @@ def test_gp_campaign_over_ros_records_the_surrogate_in_messages_and_store(client
     start_planner({**FLOW_CONFIG, "general": {"surrogate": "gp"}}, auto_propose=False)
     client.wait_matched()
     start = len(client.wait_events(0))
-    for i in range(3):
+    # the first proposal is a random pick, the next four the initial design (random feasible points until the GP has
+    # five distinct results), then the GP's
+    expected = [None] + ["random"] * 4 + ["gp"] * 2
+    for i, surrogate in enumerate(expected):
         document = json.loads(client.recommend().message)
         messages.check("proposals", document)
         (proposal,) = document["proposals"]
         assert flow_feasible(proposal["params"])
-        assert proposal.get("meta", {}).get("surrogate") == ("gp" if i else None)  # the first one is a random pick
+        assert proposal.get("meta", {}).get("surrogate") == surrogate
         client.publish(observation(proposal, value=0.2 + 0.1 * i))
         client.wait_events(start + i + 1)
     with sqlite3.connect(tmp_path / "campaign.sqlite") as db:
         stored = [json.loads(meta or "{}").get("surrogate") for (meta,) in
                   db.execute("SELECT meta FROM proposals ORDER BY created, rowid")]
-    assert stored == [None, "gp", "gp"]
+    assert stored == expected
 
 
 def test_the_node_serves_its_campaigns_dashboard_when_asked(client, start_planner, tmp_path):

@@ -135,7 +135,8 @@ def test_gp_planner_finds_the_constrained_branin_minimum():
     made = run(planner, 40, lambda p: branin(p["x0"], p["x1"]))
     assert len(made) == 40 and all(branin_feasible(p.params) for p in made)
     assert planner.best().objectives["y"] - 0.397887 < 0.01  # the kernel density needs ~100 for 0.4
-    assert made[0].meta == {} and all(p.meta == {"surrogate": "gp"} for p in made[1:])
+    assert made[0].meta == {} and [p.meta["surrogate"] for p in made[1:5]] == ["random"] * 4
+    assert all(p.meta == {"surrogate": "gp"} for p in made[5:])
 
 
 def test_gp_batches_and_pending_experiments_are_spread_out():
@@ -218,17 +219,41 @@ def config3(**general):
 
 
 def test_portfolio_is_the_default_and_its_first_model_follows_the_shape_of_the_space():
-    """No surrogate key: the portfolio. With 3 continuous parameters it starts from the GP (also before the models
-    can be compared), with 2 from the kernel density; every proposal says which model made it and why."""
+    """No surrogate key: the portfolio. With 3 continuous parameters it starts from the GP (after the initial design,
+    also before the models can be compared), with 2 from the kernel density; every proposal says which model made it
+    and why."""
     assert Planner(config3()).config.general.surrogate == "portfolio"
     three = Planner(config3(), seed=0)
-    made = run(three, 4, bowl3)
-    assert [p.meta["surrogate"] for p in made[1:]] == ["gp"] * 3
-    assert all("3 continuous parameter(s), GP first" in p.meta["surrogate_reason"] for p in made[1:])
+    made = run(three, 7, bowl3)
+    assert [p.meta["surrogate"] for p in made[5:]] == ["gp"] * 2
+    assert all("3 continuous parameter(s), GP first" in p.meta["surrogate_reason"] for p in made[5:])
     two = Planner({**config("kde"), "general": {}}, seed=0)
     made = run(two, 4, bowl)
     assert [p.meta["surrogate"] for p in made[1:]] == ["kde"] * 3
     assert all("kernel density first" in p.meta["surrogate_reason"] for p in made[1:])
+
+
+def test_the_gp_proposes_from_five_distinct_results_random_feasible_points_before():
+    """An initial design: an ask that the GP would make (`gp`, or the portfolio starting from it) proposes random
+    feasible points until the successful experiments have GP_MIN_RESULTS distinct results; failed experiments and
+    repeated results do not count, and the kernel density (two continuous parameters) is not held back."""
+    from gryffin_ros.planner.surrogates.choice import GP_MIN_RESULTS
+    constrained = {**config3(), "constraints": ["x0 + x1 <= 1.2"]}
+    for general in ({}, {"surrogate": "gp"}):
+        planner = Planner({**constrained, "general": general}, seed=2)
+        results = [None, 0.5, 0.5, None, 0.7, 0.2, 0.9]  # failures and a repeat: 4 distinct successful results
+        for y in results:
+            (proposal,) = planner.ask()
+            assert proposal.params["x0"] + proposal.params["x1"] <= 1.2
+            planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
+        assert GP_MIN_RESULTS == 5
+        made = planner.ask(2)
+        assert all(p.meta["surrogate"] == "random" and "4 distinct successful result(s)" in p.meta["surrogate_reason"]
+                   and p.params["x0"] + p.params["x1"] <= 1.2 for p in made), general
+        planner.tell({**made[0].params, "y": 0.3, "experiment_id": made[0].experiment_id})
+        assert planner.ask()[0].meta["surrogate"] == "gp", general
+    two = Planner({**config("kde"), "general": {}}, seed=0)
+    assert {p.meta["surrogate"] for p in run(two, 3, bowl)[1:]} == {"kde"}
 
 
 def test_portfolio_leaves_its_first_model_only_on_clear_evidence(monkeypatch):

@@ -23,6 +23,14 @@ if TYPE_CHECKING:  # BoTorch (~0.4 s to import) is loaded only when a GP is used
 SURROGATES = ("portfolio", "kde", "gp", "auto")
 # `auto` compares the GP with the kernel density once the successful experiments have this many distinct results.
 AUTO_MIN_OBSERVATIONS = 5
+# A GP is not asked for proposals before the successful experiments have this many distinct results: until then an
+# ask that would use it (`gp`, or `portfolio` starting from it) proposes random feasible points, an initial design
+# (BoTorch's and Ax's tutorials start from one, skopt from 10 points, Optuna from 10 trials). From one to four results
+# the GP's expected improvement, with every small categorical option to be covered twice first, spent the early
+# experiments on the conditions its few results made look least bad (m_coupling from a single random point, 12
+# seeds: regret 0.116 mean, worst 0.279; with hidden failures 0.204, worst 0.621); from five random points 0.046 and
+# 0.079 (benchmarks/README.md, round thirteen). The kernel density, Gryffin's model, proposes from the first result on.
+GP_MIN_RESULTS = 5
 # `portfolio` starts from the GP when the space has at least this many continuous parameters, from the kernel density
 # otherwise. Measured (benchmarks/README.md, "Problem portfolio" and "Surrogates on the paper's surfaces"): the GP
 # alone needs 4-5x more evaluations on the paper's 2-D plateau and rugged surfaces (Sphere, Michalewicz), where the
@@ -114,6 +122,14 @@ class SurrogateChoice:
         gp.conditioned = kept
         self.fits.put(key, gp.hyperparameters)
         return gp
+
+    def initial_design(self, levels: int) -> bool:
+        """Whether an ask's proposals are random feasible points (`GP_MIN_RESULTS`): the GP would make them (`gp`, or
+        `portfolio` starting from it) and the successful experiments have `levels` < GP_MIN_RESULTS distinct
+        results."""
+        from_gp = self.setting == "gp" or (self.setting == "portfolio" and self.objectives == 1
+                                           and self.prior() == "gp")
+        return from_gp and levels < GP_MIN_RESULTS
 
     def prior(self) -> str:
         """The model of `auto`/`portfolio` until the data clearly favour the other one."""
