@@ -1,0 +1,99 @@
+"""A campaign from the planner's first proposal: the portfolio's mixed tasks (`portfolio_tasks.py`) without the peer
+harness's five random initial points, the way a lab starts one. Optionally with hidden failures (`--hidden`):
+experiments that fail by rules the planner is not told, reported as failed (`None`).
+
+Hidden failures (m_coupling only): every experiment with Cs2CO3 fails (the base precipitates) and every one in DMF
+above 110 deg C (the solvent decomposes). Neither touches the best combination (PPh3 / K3PO4 / EtOH, at most 73 deg C
+by the known constraint), so the task's reference stays the optimum.
+
+    python -m benchmarks.from_scratch [--tasks m_coupling] [--seeds 12] [--hidden] [--processes 2]
+
+Per seed: the failed experiments (those of the second half of the budget), and the plain regret (best - reference,
+the objective's units); then mean, median, worst and worst / median per task.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+from multiprocessing import Pool
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+# the harness's `problems`, which the tasks build on (as in portfolio.py)
+sys.path.insert(0, os.environ.get("PEERS_DIR", str(ROOT.parent / "shared" / "peers")))
+
+from benchmarks import portfolio_tasks  # noqa: E402
+
+# the tasks' references (`task.reference()`, a dense grid refined by a coordinate search: portfolio.py's table)
+REFERENCES = {"m_coupling": -0.7402339145154431, "m_solvent": -0.9392404906079993}
+
+
+def hidden_failure(task, x: list) -> bool:
+    """Whether the experiment x (a harness point) fails by the hidden rules of `task` (`--hidden`)."""
+    if task.name != "m_coupling":
+        raise ValueError(f"--hidden is defined for m_coupling only, not {task.name}")
+    return task.bases[int(x[1])] == "Cs2CO3" or (task.solvents[int(x[2])] == "DMF" and x[3] > 110.0)
+
+
+def run(job: tuple[str, int, bool, int | None]) -> tuple[str, int, int, int, float]:
+    """One campaign: (task, seed, hidden failures, budget or the task's) -> (task, seed, failed experiments, failed
+    in the budget's second half, best successful value)."""
+    import torch
+
+    from benchmarks.peers.gryffin_ros_peer import config, from_planner, option_names_of, to_planner
+    from gryffin_ros.planner import Planner
+    torch.set_num_threads(1)
+    name, seed, hidden, budget = job
+    task = portfolio_tasks.TASKS[name]()
+    budget = budget or task.budget
+    names = option_names_of(task, seed)
+    index = {n: {o: i for i, o in enumerate(options)} for n, options in names.items()}
+    planner = Planner(config(task, None, False, names), seed=seed,
+                      known_constraints=lambda params: task.feasible(from_planner(task, params, index)))
+    failed, late, best = 0, 0, float("inf")
+    for experiment in range(1, budget + 1):
+        (proposal,) = planner.ask()
+        x = from_planner(task, proposal.params, index)
+        fails = hidden and hidden_failure(task, x)
+        failed += fails
+        late += fails and experiment > budget // 2
+        y = None if fails else float(task.objective(x))
+        best = best if y is None else min(best, y)
+        planner.tell({**to_planner(task, x, names), "y": y, "experiment_id": proposal.experiment_id})
+    return name, seed, failed, late, best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--tasks", default="m_coupling", help="comma-separated: " + ", ".join(REFERENCES))
+    parser.add_argument("--seeds", type=int, default=12)
+    parser.add_argument("--hidden", action="store_true", help="hidden failures (see above)")
+    parser.add_argument("--processes", type=int, default=2)
+    args = parser.parse_args()
+    tasks = args.tasks.split(",")
+    unknown = [t for t in tasks if t not in REFERENCES]
+    if unknown:
+        parser.error(f"unknown task(s) {unknown}; choose from {list(REFERENCES)}")
+    if args.hidden and tasks != ["m_coupling"]:
+        parser.error("--hidden is defined for m_coupling only")
+    jobs = [(t, s, args.hidden, None) for t in tasks for s in range(args.seeds)]
+    with Pool(args.processes) as pool:
+        results = pool.map(run, jobs, chunksize=1)
+    for t in tasks:
+        rows = [r for r in results if r[0] == t]
+        regrets = [best - REFERENCES[t] for _, _, _, _, best in rows]
+        for (_, seed, failed, late, _), regret in zip(rows, regrets):
+            print(f"{t} seed {seed}: {failed} failed ({late} in the second half), regret {regret:.4f}")
+        median = statistics.median(regrets)
+        worst = max(range(len(rows)), key=lambda i: regrets[i])
+        print(f"{t}{' (hidden failures)' if args.hidden else ''}, {len(rows)} seeds: regret mean "
+              f"{statistics.mean(regrets):.4f}, median {median:.4f}, worst {regrets[worst]:.4f} (seed "
+              f"{rows[worst][1]}), worst / median {regrets[worst] / median if median > 0 else float('inf'):.2f}; "
+              f"failed experiments {sum(r[2] for r in rows)} ({sum(r[3] for r in rows)} in second halves)")
+
+
+if __name__ == "__main__":
+    main()
