@@ -238,6 +238,7 @@ def test_the_gp_proposes_from_five_distinct_results_random_feasible_points_befor
     feasible points until the successful experiments have GP_MIN_RESULTS distinct results; failed experiments and
     repeated results do not count, and the kernel density (two continuous parameters) is not held back."""
     from gryffin_ros.planner.surrogates.choice import GP_MIN_RESULTS
+    assert GP_MIN_RESULTS == 5  # the results below give 4 distinct ones, then a 5th
     constrained = {**config3(), "constraints": ["x0 + x1 <= 1.2"]}
     for general in ({}, {"surrogate": "gp"}):
         planner = Planner({**constrained, "general": general}, seed=2)
@@ -246,7 +247,6 @@ def test_the_gp_proposes_from_five_distinct_results_random_feasible_points_befor
             (proposal,) = planner.ask()
             assert proposal.params["x0"] + proposal.params["x1"] <= 1.2
             planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
-        assert GP_MIN_RESULTS == 5
         made = planner.ask(2)
         assert all(p.meta["surrogate"] == "random" and "4 distinct successful result(s)" in p.meta["surrogate_reason"]
                    and p.params["x0"] + p.params["x1"] <= 1.2 for p in made), general

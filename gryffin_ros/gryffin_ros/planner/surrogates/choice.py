@@ -27,9 +27,10 @@ AUTO_MIN_OBSERVATIONS = 5
 # ask that would use it (`gp`, or `portfolio` starting from it) proposes random feasible points, an initial design
 # (BoTorch's and Ax's tutorials start from one, skopt from 10 points, Optuna from 10 trials). From one to four results
 # the GP's expected improvement, with every small categorical option to be covered twice first, spent the early
-# experiments on the conditions its few results made look least bad (m_coupling from a single random point, 12
-# seeds: regret 0.116 mean, worst 0.279; with hidden failures 0.204, worst 0.621); from five random points 0.046 and
-# 0.079 (benchmarks/README.md, round thirteen). The kernel density, Gryffin's model, proposes from the first result on.
+# experiments on the conditions its few results made look least bad (m_coupling from the planner's first proposal, 24
+# seeds: regret mean 0.098, worst 0.282; with hidden failures 0.205, worst 0.686); with the initial design 0.047 /
+# 0.124 and 0.067 / 0.299 (benchmarks/README.md, round thirteen). The kernel density, Gryffin's model, proposes from
+# the first result on.
 GP_MIN_RESULTS = 5
 # `portfolio` starts from the GP when the space has at least this many continuous parameters, from the kernel density
 # otherwise. Measured (benchmarks/README.md, "Problem portfolio" and "Surrogates on the paper's surfaces"): the GP
