@@ -13,6 +13,15 @@ Regions (--region):
   its two global minima inside, 0.015 from the region's edge; the other, (0.485, 0.678), feasible.
 - camel-open: the six-hump camel with no failing region; with --failure-rate, failures at random only.
 
+Three more, added after the default's failure handling was tuned (round fourteen of benchmarks/README.md), to see
+whether it carries over to shapes it was not tuned on:
+- himmelblau: Himmelblau's function (x0, x1 -> [-5, 5], / 100) with the quarter x0 > 0.5 and x1 > 0.5 failing: one
+  of its four global minima (0.8, 0.7) inside, the other three feasible.
+- disc: a disc of radius 0.25 around (0.37, 0.32) fails (not axis-aligned); a bowl with a wave whose minimum,
+  (0.593, 0.45), lies 0.008 outside the disc.
+- diagonal: the half-square x0 + x1 > 1 fails (an oblique edge); (x0 - 0.6)^2 + 2 (x1 - 0.5)^2 has its minimum
+  inside, the best feasible point (0.533, 0.467) on the edge (as holds-optimum: probes of it fail about half the time).
+
 With --failure-rate R every experiment also fails with probability R wherever it is (an instrument's random failures;
 drawn from a generator seeded by the run's seed, the same draws whatever the planner proposes). The last line then
 also counts the runs that ended STUCK_REGRET or more short of the best feasible value (on the camel: on one of its
@@ -21,7 +30,8 @@ local minima, -0.2155, regret 0.82, instead of a global one).
 With --dims D > 2 the square becomes the unit cube of D dims: the region fails by x0 and x1 alone (a slab), and
 each further coordinate adds EXTRA_WEIGHT (x_i - EXTRA_CENTRE)^2 to the objective, so the optimum's value stays.
 
-    python -m benchmarks.failing_region [--seeds 5] [--region edge|branin|holds-optimum|camel|camel-open]
+    python -m benchmarks.failing_region [--seeds 5]
+                                        [--region edge|branin|holds-optimum|camel|camel-open|himmelblau|disc|diagonal]
                                         [--feas-model kde|gp] [--surrogate kde|gp|auto|portfolio]
                                         [--feas-approach fwt|fwa|fia|fca] [--dims 2] [--failure-rate 0]
 """
@@ -60,12 +70,27 @@ def six_hump_camel(x0: float, x1: float) -> float:
     return (4 - 2.1 * x * x + x ** 4 / 3) * x * x + x * y + (4 * y * y - 4) * y * y
 
 
+def himmelblau(x0: float, x1: float) -> float:
+    """Himmelblau's function on the unit square (x0, x1 -> [-5, 5]) / 100: four global minima 0, at (0.8, 0.7),
+    (0.2195, 0.8131), (0.1221, 0.1717) and (0.8584, 0.3152)."""
+    x, y = 10 * x0 - 5, 10 * x1 - 5
+    return ((x * x + y - 11) ** 2 + (x + y * y - 7) ** 2) / 100
+
+
+def wavy_bowl(x0: float, x1: float) -> float:
+    """A bowl with a wave along x0: its minimum -0.0337 at (0.593, 0.45)."""
+    return (x0 - 0.5) ** 2 + (x1 - 0.45) ** 2 + 0.05 * math.sin(7 * x0)
+
+
 REGIONS = {  # name: (objective, fails)
     "edge": (objective, inside),
     "branin": (lambda x0, x1: float(branin(x0, x1)) / 100, lambda x0, x1: x0 > 0.5 and x1 < 0.5),
     "holds-optimum": (lambda x0, x1: (x0 - 0.65) ** 2 + (x1 - 0.7) ** 2, inside),
     "camel": (six_hump_camel, lambda x0, x1: x0 > 0.5 and x1 < 0.5),
     "camel-open": (six_hump_camel, lambda x0, x1: False),
+    "himmelblau": (himmelblau, inside),
+    "disc": (wavy_bowl, lambda x0, x1: (x0 - 0.37) ** 2 + (x1 - 0.32) ** 2 < 0.25 ** 2),
+    "diagonal": (lambda x0, x1: (x0 - 0.6) ** 2 + 2 * (x1 - 0.5) ** 2, lambda x0, x1: x0 + x1 > 1.0),
 }
 DEEP = 0.03
 STUCK_REGRET = 0.5
