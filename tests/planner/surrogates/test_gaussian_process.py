@@ -256,6 +256,29 @@ def test_the_gp_proposes_from_five_distinct_results_random_feasible_points_befor
     assert {p.meta["surrogate"] for p in run(two, 3, bowl)[1:]} == {"kde"}
 
 
+def test_the_initial_design_ends_at_ten_successful_experiments_when_the_results_take_few_values():
+    """An objective with three possible values (a rating of 0, 1 or 2) never has GP_MIN_RESULTS distinct results:
+    the initial design ends after INITIAL_DESIGN_MAX successful experiments (failed ones do not count); then the
+    portfolio proposes from the kernel density and says why, and `surrogate: gp` from the GP."""
+    from gryffin_ros.planner.surrogates.choice import GP_MIN_RESULTS, INITIAL_DESIGN_MAX
+    assert INITIAL_DESIGN_MAX == 10 and GP_MIN_RESULTS > 3
+    for general, model in (({}, "kde"), ({"surrogate": "gp"}, "gp")):
+        planner = Planner({**config3(), "general": general}, seed=3)
+        ratings = [0.0, 1.0, None, 2.0, 0.0, 1.0, 1.0, None, 0.0, 2.0, 1.0]  # 9 successful, 3 distinct
+        for y in ratings:
+            (proposal,) = planner.ask()
+            planner.tell({**proposal.params, "y": y, "experiment_id": proposal.experiment_id})
+        (proposal,) = planner.ask()
+        assert proposal.meta["surrogate"] == "random", general
+        assert "3 distinct successful result(s)" in proposal.meta["surrogate_reason"]
+        assert "from 10 successful experiments" in proposal.meta["surrogate_reason"]
+        planner.tell({**proposal.params, "y": 2.0, "experiment_id": proposal.experiment_id})  # the 10th
+        made = planner.ask(2)
+        assert [p.meta["surrogate"] for p in made] == [model, model], general
+        if model == "kde":
+            assert "3 distinct results in 10 successful experiments" in made[0].meta["surrogate_reason"]
+
+
 def test_portfolio_leaves_its_first_model_only_on_clear_evidence(monkeypatch):
     """With the GP first, the kernel density takes over only when its held-out ranking is better by more than the
     score's sampling error: a kernel density that ranks the observations perfectly takes over, one that ranks them

@@ -19,7 +19,7 @@ from ..domain import ConstraintArg, Observation
 from ..history import History
 from ..optimizers import AcquisitionOptimizer, make_optimizer
 from ..reporting import report
-from ..surrogates.choice import GP_MIN_RESULTS, SurrogateChoice
+from ..surrogates.choice import GP_MIN_RESULTS, INITIAL_DESIGN_MAX, SurrogateChoice
 from ..surrogates.descriptors import LearnedDescriptors, learn_many
 from ..surrogates.kernel_density import KernelDensity
 from .base import BasePlanner
@@ -249,9 +249,10 @@ class Planner(BasePlanner):
             return self._away_from_failures(n, rng, observed, chosen, feasibility), [None] * n, dict(feasibility.notes)
         X, merits, descriptors, density = models.X, models.merits, models.descriptors, models.density
         levels = len(np.unique(merits))
-        if self.surrogate_choice.initial_design(levels):
+        if self.surrogate_choice.initial_design(levels, len(merits)):
             meta = {"surrogate": "random", "surrogate_reason": f"initial design: {levels} distinct successful "
-                    f"result(s); the GP proposes from {GP_MIN_RESULTS} on"}
+                    f"result(s); the GP proposes from {GP_MIN_RESULTS} on, or from {INITIAL_DESIGN_MAX} successful "
+                    "experiments"}
             meta.update(feasibility.notes if feasibility is not None else {})
             return self.random_points(n, rng, np.concatenate([observed, chosen])), [None] * n, meta
         gp, meta = self.surrogate_choice.choose(X, merits, successful, density, descriptors)

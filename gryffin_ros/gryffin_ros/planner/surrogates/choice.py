@@ -32,6 +32,12 @@ AUTO_MIN_OBSERVATIONS = 5
 # 0.124 and 0.067 / 0.299 (benchmarks/README.md, round thirteen). The kernel density, Gryffin's model, proposes from
 # the first result on.
 GP_MIN_RESULTS = 5
+# ... or until this many successful experiments, whatever their distinct results: an objective with fewer possible
+# values (a rating of 0, 1 or 2; pass or fail) never reaches GP_MIN_RESULTS of them, and every proposal of such a
+# campaign stayed random (3 continuous parameters, a 3-level rating: 24 of 24 asks). `portfolio` then proposes from
+# the kernel density (`choose`): with a rating of 0/1/2 of 3 continuous conditions, 40 experiments, 24 seeds, the
+# campaigns reached the top rating in 14 seeds that way, in 8 with the GP (benchmarks/README.md, round fourteen).
+INITIAL_DESIGN_MAX = 2 * GP_MIN_RESULTS
 # `portfolio` starts from the GP when the space has at least this many continuous parameters, from the kernel density
 # otherwise. Measured (benchmarks/README.md, "Problem portfolio" and "Surrogates on the paper's surfaces"): the GP
 # alone needs 4-5x more evaluations on the paper's 2-D plateau and rugged surfaces (Sphere, Michalewicz), where the
@@ -124,13 +130,13 @@ class SurrogateChoice:
         self.fits.put(key, gp.hyperparameters)
         return gp
 
-    def initial_design(self, levels: int) -> bool:
+    def initial_design(self, levels: int, successes: int) -> bool:
         """Whether an ask's proposals are random feasible points (`GP_MIN_RESULTS`): the GP would make them (`gp`, or
-        `portfolio` starting from it) and the successful experiments have `levels` < GP_MIN_RESULTS distinct
-        results."""
+        `portfolio` starting from it) and the `successes` successful experiments, fewer than INITIAL_DESIGN_MAX, have
+        `levels` < GP_MIN_RESULTS distinct results."""
         from_gp = self.setting == "gp" or (self.setting == "portfolio" and self.objectives == 1
                                            and self.prior() == "gp")
-        return from_gp and levels < GP_MIN_RESULTS
+        return from_gp and levels < GP_MIN_RESULTS and successes < INITIAL_DESIGN_MAX
 
     def prior(self) -> str:
         """The model of `auto`/`portfolio` until the data clearly favour the other one."""
@@ -159,6 +165,9 @@ class SurrogateChoice:
         shape = (f"{self.setting}: {len(self.space.cont_idx)} continuous parameter(s), "
                  f"{'GP' if prior == 'gp' else 'kernel density'} first")
         levels = len(np.unique(merits))
+        if levels < AUTO_MIN_OBSERVATIONS and prior == "gp" and self.setting == "portfolio":
+            return None, {"surrogate": "kde", "surrogate_reason": f"{shape}; {levels} distinct results in "
+                          f"{len(merits)} successful experiments: a result with few values, the kernel density"}
         if levels < AUTO_MIN_OBSERVATIONS:
             gp = self.gaussian_process(X, successful, descriptors) if prior == "gp" else None
             return gp, {"surrogate": prior, "surrogate_reason": f"{shape}; fewer than {AUTO_MIN_OBSERVATIONS} "
