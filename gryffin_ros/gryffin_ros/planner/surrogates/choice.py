@@ -153,7 +153,10 @@ class SurrogateChoice:
         calibrated values). The other model replaces the prior one (`prior()`) only when it ranks better by more than
         the sampling error of the score (Fisher z of Spearman's r, s.e. sqrt(1.06 / (m - 3))), m the number of
         distinct merits: tied results carry no ranking, so on plateaus (a step-shaped surface with a few levels) the
-        score says little and the prior model stays; never with fewer than AUTO_MIN_OBSERVATIONS distinct merits."""
+        score says little and the prior model stays; never with fewer than AUTO_MIN_OBSERVATIONS distinct merits.
+        With fewer than that, `portfolio` proposes from the kernel density even where the GP comes first: its initial
+        design (`initial_design`) has then ended after INITIAL_DESIGN_MAX successful experiments, so the results take
+        few values (a rating), where the kernel density did better."""
         if self.setting == "kde":
             return None, {"surrogate": "kde"}
         if self.setting == "gp":
