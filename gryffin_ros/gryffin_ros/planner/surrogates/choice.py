@@ -168,13 +168,12 @@ class SurrogateChoice:
         shape = (f"{self.setting}: {len(self.space.cont_idx)} continuous parameter(s), "
                  f"{'GP' if prior == 'gp' else 'kernel density'} first")
         levels = len(np.unique(merits))
-        if levels < AUTO_MIN_OBSERVATIONS and prior == "gp" and self.setting == "portfolio":
-            return None, {"surrogate": "kde", "surrogate_reason": f"{shape}; {levels} distinct results in "
-                          f"{len(merits)} successful experiments: a result with few values, the kernel density"}
         if levels < AUTO_MIN_OBSERVATIONS:
-            gp = self.gaussian_process(X, successful, descriptors) if prior == "gp" else None
-            return gp, {"surrogate": prior, "surrogate_reason": f"{shape}; fewer than {AUTO_MIN_OBSERVATIONS} "
-                        "distinct successful results to compare the models on"}
+            if prior == "gp":  # (portfolio) its initial design ended at INITIAL_DESIGN_MAX successful experiments
+                return None, {"surrogate": "kde", "surrogate_reason": f"{shape}; {levels} distinct results in "
+                              f"{len(merits)} successful experiments: a result with few values, the kernel density"}
+            return None, {"surrogate": "kde", "surrogate_reason": f"{shape}; fewer than {AUTO_MIN_OBSERVATIONS} "
+                          "distinct successful results to compare the models on"}
         from .gaussian_process import rank_correlation
         gp = self.gaussian_process(X, successful, descriptors)
         kept = gp.conditioned  # both models are scored on the observations the GP is conditioned on
