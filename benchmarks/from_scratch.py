@@ -1,13 +1,14 @@
 """A campaign from the planner's first proposal: tasks of the portfolio (`portfolio_tasks.py`; the mixed ones, the
 6-D Hartmann, the kinetics) without the peer harness's five random initial points, the way a lab starts one.
 Optionally with hidden failures (`--hidden`): experiments that fail by rules the planner is not told, reported as
-failed (`None`).
+failed (`None`). With `--failure-rate R` each experiment also fails with probability R, wherever it is (a blocked line,
+a cracked vial; the draws of failing_region.py's option).
 
 Hidden failures (m_coupling only): every experiment with Cs2CO3 fails (the base precipitates) and every one in DMF
 above 110 deg C (the solvent decomposes). Neither touches the best combination (PPh3 / K3PO4 / EtOH, at most 73 deg C
 by the known constraint), so the task's reference stays the optimum.
 
-    python -m benchmarks.from_scratch [--tasks m_coupling] [--seeds 12] [--hidden] [--processes 2]
+    python -m benchmarks.from_scratch [--tasks m_coupling] [--seeds 12] [--hidden] [--failure-rate R] [--processes 2]
 
 Per seed: the failed experiments (those of the second half of the budget), and the plain regret (best - reference,
 the objective's units); then mean, median, worst and worst / median per task.
@@ -41,17 +42,19 @@ def hidden_failure(task, x: list) -> bool:
     return task.bases[int(x[1])] == "Cs2CO3" or (task.solvents[int(x[2])] == "DMF" and x[3] > 110.0)
 
 
-def run(job: tuple[str, int, bool, int | None]) -> tuple[str, int, int, int, float]:
-    """One campaign: (task, seed, hidden failures, budget or the task's) -> (task, seed, failed experiments, failed
-    in the budget's second half, best successful value)."""
+def run(job: tuple[str, int, bool, int | None, float]) -> tuple[str, int, int, int, float]:
+    """One campaign: (task, seed, hidden failures, budget or the task's, rate of random failures) -> (task, seed,
+    failed experiments, failed in the budget's second half, best successful value)."""
     import torch
 
     from benchmarks.peers.gryffin_ros_peer import config, from_planner, option_names_of, to_planner
     from gryffin_ros.planner import Planner
     torch.set_num_threads(1)
-    name, seed, hidden, budget = job
+    from benchmarks.failing_region import failure_draws
+    name, seed, hidden, budget, failure_rate = job
     task = portfolio_tasks.TASKS[name]()
     budget = budget or task.budget
+    at_random = failure_draws(seed, failure_rate, budget)
     names = option_names_of(task, seed)
     index = {n: {o: i for i, o in enumerate(options)} for n, options in names.items()}
     planner = Planner(config(task, None, False, names), seed=seed,
@@ -60,7 +63,7 @@ def run(job: tuple[str, int, bool, int | None]) -> tuple[str, int, int, int, flo
     for experiment in range(1, budget + 1):
         (proposal,) = planner.ask()
         x = from_planner(task, proposal.params, index)
-        fails = hidden and hidden_failure(task, x)
+        fails = (hidden and hidden_failure(task, x)) or at_random[experiment - 1]
         failed += fails
         late += fails and experiment > budget // 2
         y = None if fails else float(task.objective(x))
@@ -74,6 +77,8 @@ def main() -> None:
     parser.add_argument("--tasks", default="m_coupling", help="comma-separated: " + ", ".join(REFERENCES))
     parser.add_argument("--seeds", type=int, default=12)
     parser.add_argument("--hidden", action="store_true", help="hidden failures (see above)")
+    parser.add_argument("--failure-rate", type=float, default=0.0,
+                        help="each experiment also fails with this probability, wherever it is")
     parser.add_argument("--processes", type=int, default=2)
     args = parser.parse_args()
     tasks = args.tasks.split(",")
@@ -82,7 +87,9 @@ def main() -> None:
         parser.error(f"unknown task(s) {unknown}; choose from {list(REFERENCES)}")
     if args.hidden and tasks != ["m_coupling"]:
         parser.error("--hidden is defined for m_coupling only")
-    jobs = [(t, s, args.hidden, None) for t in tasks for s in range(args.seeds)]
+    if not 0.0 <= args.failure_rate < 1.0:
+        parser.error(f"--failure-rate must be in [0, 1), got {args.failure_rate}")
+    jobs = [(t, s, args.hidden, None, args.failure_rate) for t in tasks for s in range(args.seeds)]
     with Pool(args.processes) as pool:
         results = pool.map(run, jobs, chunksize=1)
     for t in tasks:
@@ -92,7 +99,8 @@ def main() -> None:
             print(f"{t} seed {seed}: {failed} failed ({late} in the second half), regret {regret:.4f}")
         median = statistics.median(regrets)
         worst = max(range(len(rows)), key=lambda i: regrets[i])
-        print(f"{t}{' (hidden failures)' if args.hidden else ''}, {len(rows)} seeds: regret mean "
+        at_random = f" ({args.failure_rate:g} failing at random)" if args.failure_rate else ""
+        print(f"{t}{' (hidden failures)' if args.hidden else ''}{at_random}, {len(rows)} seeds: regret mean "
               f"{statistics.mean(regrets):.4f}, median {median:.4f}, worst {regrets[worst]:.4f} (seed "
               f"{rows[worst][1]}), worst / median {regrets[worst] / median if median > 0 else float('inf'):.2f}; "
               f"failed experiments {sum(r[2] for r in rows)} ({sum(r[3] for r in rows)} in second halves)")

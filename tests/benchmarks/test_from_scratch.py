@@ -15,7 +15,12 @@ def test_the_hidden_rules_fail_cs2co3_and_hot_dmf_only():
 
 
 def test_a_short_campaign_counts_its_failures_and_keeps_the_best_success():
-    name, seed, failed, late, best = from_scratch.run(("m_coupling", 0, True, 6))
+    name, seed, failed, late, best = from_scratch.run(("m_coupling", 0, True, 6, 0.0))
     assert (name, seed) == ("m_coupling", 0) and 0 <= late <= failed <= 6
     assert math.isinf(best) == (failed == 6)
     assert math.isinf(best) or -1.0 < best < 1.0  # a yield minus the reagent and time costs
+
+
+def test_failures_at_random_come_on_top_of_the_hidden_rules():
+    name, seed, failed, late, best = from_scratch.run(("m_coupling", 3, False, 6, 0.999))
+    assert failed == 6 and late == 3 and math.isinf(best)

@@ -7,6 +7,7 @@ import torch
 
 from benchmarks.failing_region import deep
 from gryffin_ros.planner import Planner, load_config
+from gryffin_ros.planner.acquisition import feasibility
 from gryffin_ros.planner.acquisition.feasibility import FeasibilityModel, combine
 from tests.conftest import branin
 
@@ -32,6 +33,63 @@ def test_probability_is_low_near_failures_high_near_successes_and_the_prior_far_
     assert m.prior == pytest.approx(9 / 18)
     assert p_far == pytest.approx(m.prior, abs=0.1)
     assert 0.0 <= m.probability(rng.random((200, 2))).min() <= m.probability(rng.random((200, 2))).max() <= 1.0
+
+
+def coupling(bases: int = 4) -> Planner:
+    """A ligand, a base and a solvent (categorical) and three conditions, as in a coupling screen."""
+    return Planner({"parameters": [{"name": "ligand", "type": "categorical", "options": [f"l{i}" for i in range(5)]},
+                                   {"name": "base", "type": "categorical", "options": [f"b{i}" for i in range(bases)]},
+                                   {"name": "solvent", "type": "categorical", "options": [f"s{i}" for i in range(5)]}]
+                    + [{"name": f"c{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(3)],
+                    "objectives": [{"name": "y", "goal": "min"}]}, seed=0)
+
+
+def base_failures(seed: int, bases: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """Internal points and failure labels: bases 0-2 succeed (20 random points, and 3 at the conditions QUERY[0] holds);
+    base 3 failed in each of its 4 runs, at random other points."""
+    rng = np.random.default_rng(seed)
+
+    def draw(n, base):
+        return np.c_[rng.integers(0, 5, n), rng.integers(0, 3, n) if base is None else np.full(n, base),
+                     rng.integers(0, 5, n), rng.random((n, 3))]
+    ok = np.concatenate([draw(20, None), [[2, b, 1, 0.5, 0.0, 0.0] for b in range(3)]])
+    return np.concatenate([ok, draw(4, 3)]), np.array([False] * len(ok) + [True] * 4)
+
+
+QUERY = np.array([[2, 0, 1, 0.5, 0.0, 0.0], [2, 3, 1, 0.5, 0.0, 0.0]])  # base 0, then base 3, at the same conditions
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_an_option_that_failed_in_every_run_is_unlikely_wherever_it_is_set(seed, monkeypatch):
+    planner = coupling()
+    X, failed = base_failures(seed)
+    p = FeasibilityModel(planner.space, X, failed, 1.0, torch.Generator().manual_seed(seed)).probability(QUERY)
+    monkeypatch.setattr(feasibility, "OPTION_PRIOR_WEIGHT", 0.0)
+    kernels = FeasibilityModel(planner.space, X, failed, 1.0, torch.Generator().manual_seed(seed)).probability(QUERY)
+    # what the rule is for: the kernels alone, local in all six coordinates at once, let the successes of the other
+    # bases at these conditions vouch for base 3
+    assert kernels[1] > 0.5
+    # base 3's rate: (0 successes + prior) / (4 runs + 1 pseudo-run), against the prior: a factor 1/5
+    assert p[1] == pytest.approx(kernels[1] / 5) and p[1] < 0.25
+    assert p[0] == kernels[0] > 0.8  # a base that never failed: unchanged
+
+
+def test_an_option_that_failed_once_among_many_successes_keeps_most_of_its_probability():
+    planner = coupling()
+    X, failed = base_failures(0)
+    failed[np.flatnonzero(X[:, 1] == 0)[0]] = True  # one run of base 0 failed too
+    factors = FeasibilityModel(planner.space, X, failed, 1.0, torch.Generator().manual_seed(0)).option_factors
+    assert factors[1][0] > 0.8 and factors[1][1] == factors[1][2] == 1.0 and factors[1][3] < 0.25
+    # the ligand and the solvent have factors too: their options that ran with base 3 share its failures (a marginal
+    # rate cannot tell which parameter failed), milder than base 3's own
+    assert set(factors) == {0, 1, 2} and min(factors[0].min(), factors[2].min()) > factors[1][3]
+
+
+def test_a_parameter_with_many_options_has_no_option_factor():
+    bases = feasibility.OPTION_MAX_OPTIONS + 1
+    planner = coupling(bases)
+    X, failed = base_failures(0, bases)
+    assert 1 not in FeasibilityModel(planner.space, X, failed, 1.0, torch.Generator().manual_seed(0)).option_factors
 
 
 def test_combinations_follow_their_definitions():

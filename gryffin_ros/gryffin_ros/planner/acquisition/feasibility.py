@@ -8,7 +8,8 @@ between options) has the constant prior pi = (n_ok + 1) / (n + 2) and c = WIDE_P
 kernels decide, between them the wide ones extend what was seen, far from everything P = pi. Each estimate is 1 -
 alpha of the kernel acquisition with the failure labels as merits, so the same numerics (log space, no underflow)
 serve both. With general.feas_model = gp a GP classifier of feasibility (`surrogates.gp_classifier`, Atlas' model)
-takes the wide estimate's place as the narrow kernels' prior.
+takes the wide estimate's place as the narrow kernels' prior. An option of a small categorical parameter that fails more
+often than the campaign's experiments do lowers P wherever it is set (`option_factors`).
 """
 
 from __future__ import annotations
@@ -38,6 +39,16 @@ FWT_THRESHOLD = 0.5
 # with three, the failing regions and the paper's surfaces with unknown constraints within noise
 # (benchmarks/README.md, round twelve).
 WIDE_PRIOR_WEIGHT = 3.0
+# An option that fails more often than the campaign's experiments do, whatever the rest of the point: P(feasible) is
+# scaled by min(1, r_o / pi) for each option o of a categorical parameter with 2 to OPTION_MAX_OPTIONS options, r_o its
+# success rate with pi as a prior worth OPTION_PRIOR_WEIGHT experiments, (successes + w pi) / (runs + w). The kernels
+# are local in every coordinate at once: after a base had failed in all of its 4 to 6 runs, a point with that base
+# beside successes with other bases still got P 0.99 - 1.00 (m_coupling from scratch, Cs2CO3 failing). Options that
+# never failed keep their P. With w = 1, 48 campaigns with hidden failures: 291 -> 203 failed experiments, 66 -> 28 in
+# the second halves; with failures at random the same regret (benchmarks/README.md, round fifteen). With many options
+# (a molecule library, a grid's cells) each has too few runs for a rate of its own; the kernels share what they learn.
+OPTION_PRIOR_WEIGHT = 1.0
+OPTION_MAX_OPTIONS = 10
 
 
 def weight(p_feasible: np.ndarray, approach: str) -> np.ndarray:
@@ -45,6 +56,23 @@ def weight(p_feasible: np.ndarray, approach: str) -> np.ndarray:
     if approach == "fwt":
         return np.minimum(1.0, p_feasible / FWT_THRESHOLD)
     return p_feasible
+
+
+def option_factors(space: SearchSpace, X: np.ndarray, failed: np.ndarray, prior: float) -> dict[int, np.ndarray]:
+    """By finite dim of each categorical parameter with 2 to OPTION_MAX_OPTIONS options: the factor of each option on
+    P(feasible), min(1, r / prior), r the option's success rate among the experiments X with `prior` worth
+    OPTION_PRIOR_WEIGHT of them (none with a weight of 0)."""
+    out = {}
+    for d in space.finite_idx if OPTION_PRIOR_WEIGHT > 0 else ():
+        parameter = space.parameters[int(d)]
+        if parameter.kind != "categorical" or not 2 <= len(parameter.options) <= OPTION_MAX_OPTIONS:
+            continue
+        options = np.rint(X[:, d]).astype(int)
+        runs = np.bincount(options, minlength=len(parameter.options))
+        successes = np.bincount(options[~failed], minlength=len(parameter.options))
+        rate = (successes + OPTION_PRIOR_WEIGHT * prior) / (runs + OPTION_PRIOR_WEIGHT)
+        out[int(d)] = np.minimum(1.0, rate / prior)
+    return out
 
 
 def no_descriptors(space: SearchSpace) -> dict[int, None]:
@@ -83,15 +111,19 @@ class FeasibilityModel:
                                                                            feasible_fraction, generator, descriptors)
         narrow = KernelDensity(space, X, labels, feasible_fraction, generator, descriptors=no_descriptors(space))
         self._narrow = (Acquisition(narrow, 0.0), Acquisition(narrow, 1.0))
+        self.option_factors = option_factors(space, X, np.asarray(failed, dtype=bool), self.prior)
 
     def probability(self, X: np.ndarray) -> np.ndarray:
         """(M, D) internal points -> (M,) P(feasible): Gryffin's narrow kernels, each option on its own, with the
         wide estimate (kernels as wide as the data spacing, descriptors shared, or the GP classifier) as their
         prior instead of a constant: near observations the narrow kernels decide, elsewhere the prior extends what was
-        seen."""
+        seen; times the factor of each option the point holds (`option_factors`)."""
         prior = self._wide.probability(X)
         alpha0, alpha1 = (a.evaluate(X) for a in self._narrow)  # S_fail/(S+u) and (S_fail+u)/(S+u)
-        return 1.0 - alpha0 - (1.0 - prior) * (alpha1 - alpha0)
+        p = 1.0 - alpha0 - (1.0 - prior) * (alpha1 - alpha0)
+        for d, factor in self.option_factors.items():
+            p = p * factor[np.rint(X[:, d]).astype(int)]
+        return p
 
 
 def combine(alpha: np.ndarray, p_feasible: np.ndarray, approach: str, feas_param: float,
