@@ -28,6 +28,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, os.environ.get("PEERS_DIR", str(ROOT.parent / "shared" / "peers")))
 
 from benchmarks import portfolio_tasks  # noqa: E402
+from benchmarks.failing_region import failure_draws  # noqa: E402
 
 # the tasks' references (`task.reference()`: the closed-form optimum, or a dense grid refined by a coordinate search;
 # portfolio.py's table, results/portfolio.json)
@@ -50,7 +51,6 @@ def run(job: tuple[str, int, bool, int | None, float]) -> tuple[str, int, int, i
     from benchmarks.peers.gryffin_ros_peer import config, from_planner, option_names_of, to_planner
     from gryffin_ros.planner import Planner
     torch.set_num_threads(1)
-    from benchmarks.failing_region import failure_draws
     name, seed, hidden, budget, failure_rate = job
     task = portfolio_tasks.TASKS[name]()
     budget = budget or task.budget

@@ -21,6 +21,6 @@ def test_a_short_campaign_counts_its_failures_and_keeps_the_best_success():
     assert math.isinf(best) or -1.0 < best < 1.0  # a yield minus the reagent and time costs
 
 
-def test_failures_at_random_come_on_top_of_the_hidden_rules():
+def test_failures_at_random_fail_experiments_wherever_they_are():
     name, seed, failed, late, best = from_scratch.run(("m_coupling", 3, False, 6, 0.999))
     assert failed == 6 and late == 3 and math.isinf(best)

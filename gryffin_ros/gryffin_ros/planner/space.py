@@ -71,6 +71,12 @@ class SearchSpace:
         """Log of the domain volume in internal units: 1 per continuous dim, the option count per finite dim."""
         return float(np.log(self.n_options).sum())
 
+    def small_categorical_dims(self, max_options: int) -> list[int]:
+        """The dims of the categorical parameters with 2 to `max_options` options: few enough that each option gets
+        runs of its own in a campaign."""
+        return [int(d) for d in self.finite_idx
+                if self.parameters[d].kind == "categorical" and 2 <= len(self.parameters[d].options) <= max_options]
+
     # ---- conversions ---------------------------------------------------------------------------------------
     def to_internal(self, rows: Sequence[Mapping[str, Any]]) -> np.ndarray:
         """Validate parameter dicts and convert them: (M,) dicts -> (M, D) internal array."""

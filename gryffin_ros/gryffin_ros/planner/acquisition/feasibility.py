@@ -62,16 +62,15 @@ def option_factors(space: SearchSpace, X: np.ndarray, failed: np.ndarray, prior:
     """By finite dim of each categorical parameter with 2 to OPTION_MAX_OPTIONS options: the factor of each option on
     P(feasible), min(1, r / prior), r the option's success rate among the experiments X with `prior` worth
     OPTION_PRIOR_WEIGHT of them (none with a weight of 0)."""
-    out = {}
-    for d in space.finite_idx if OPTION_PRIOR_WEIGHT > 0 else ():
-        parameter = space.parameters[int(d)]
-        if parameter.kind != "categorical" or not 2 <= len(parameter.options) <= OPTION_MAX_OPTIONS:
-            continue
+    out: dict[int, np.ndarray] = {}
+    if OPTION_PRIOR_WEIGHT <= 0:
+        return out
+    for d in space.small_categorical_dims(OPTION_MAX_OPTIONS):
         options = np.rint(X[:, d]).astype(int)
-        runs = np.bincount(options, minlength=len(parameter.options))
-        successes = np.bincount(options[~failed], minlength=len(parameter.options))
+        runs = np.bincount(options, minlength=int(space.n_options[d]))
+        successes = np.bincount(options[~failed], minlength=int(space.n_options[d]))
         rate = (successes + OPTION_PRIOR_WEIGHT * prior) / (runs + OPTION_PRIOR_WEIGHT)
-        out[int(d)] = np.minimum(1.0, rate / prior)
+        out[d] = np.minimum(1.0, rate / prior)
     return out
 
 

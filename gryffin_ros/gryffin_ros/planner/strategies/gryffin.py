@@ -376,13 +376,10 @@ class Planner(BasePlanner):
         """(dim, option) of the options of categorical parameters with 2 to COVER_MAX_OPTIONS options that fewer than
         COVER_TRIES of `points` (observed and pending experiments, internal units) hold."""
         out = []
-        for d in self.space.finite_idx:
-            parameter = self.space.parameters[int(d)]
-            if parameter.kind != "categorical" or not 2 <= len(parameter.options) <= COVER_MAX_OPTIONS:
-                continue
-            counts = np.bincount(np.rint(points[:, d]).astype(int), minlength=len(parameter.options)) \
-                if len(points) else np.zeros(len(parameter.options), dtype=int)
-            out += [(int(d), int(o)) for o in np.flatnonzero(counts < COVER_TRIES)]
+        for d in self.space.small_categorical_dims(COVER_MAX_OPTIONS):
+            counts = np.bincount(np.rint(points[:, d]).astype(int), minlength=int(self.space.n_options[d])) \
+                if len(points) else np.zeros(int(self.space.n_options[d]), dtype=int)
+            out += [(d, int(o)) for o in np.flatnonzero(counts < COVER_TRIES)]
         return out
 
     def _covering_candidates(self, acquisition: AcquisitionFunction, under: list[tuple[int, int]],
