@@ -85,6 +85,18 @@ def test_an_option_that_failed_once_among_many_successes_keeps_most_of_its_proba
     assert set(factors) == {0, 1, 2} and min(factors[0].min(), factors[2].min()) > factors[1][3]
 
 
+def test_a_campaign_s_proposals_name_the_option_that_keeps_failing():
+    planner = coupling()
+    X, failed = base_failures(0)
+    names = planner.space.names
+    rows = [{**{n: planner.space.parameters[d].options[int(x[d])] for d, n in enumerate(names[:3])},
+             **{n: float(x[d]) for d, n in enumerate(names) if d >= 3},
+             "y": None if bad else float(np.sum((x[3:] - 0.4) ** 2))} for x, bad in zip(X, failed)]
+    planner.tell(rows)
+    (proposal,) = planner.ask()
+    assert proposal.meta["failing_options"] == "base=b3 (0 of 4 succeeded)"
+
+
 def test_a_parameter_with_many_options_has_no_option_factor():
     bases = feasibility.OPTION_MAX_OPTIONS + 1
     planner = coupling(bases)

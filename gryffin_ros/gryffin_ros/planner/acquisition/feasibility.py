@@ -74,6 +74,19 @@ def option_factors(space: SearchSpace, X: np.ndarray, failed: np.ndarray, prior:
     return out
 
 
+def failing_options(space: SearchSpace, X: np.ndarray, failed: np.ndarray, factors: dict[int, np.ndarray]) -> str:
+    """What a proposal's meta says of the options whose factor at least halves P: "base=Cs2CO3 (0 of 4 succeeded)",
+    "; "-separated ("" for none)."""
+    out = []
+    for d, factor in factors.items():
+        options = np.rint(X[:, d]).astype(int)
+        for o in np.flatnonzero(factor <= 0.5):
+            runs = options == o
+            out.append(f"{space.names[d]}={space.parameters[d].options[o]} ({int((runs & ~failed).sum())} of "
+                       f"{int(runs.sum())} succeeded)")
+    return "; ".join(out)
+
+
 def no_descriptors(space: SearchSpace) -> dict[int, None]:
     """Descriptor overrides that make every finite dim's kernel treat each option on its own."""
     return {int(d): None for d in space.finite_idx}
@@ -103,7 +116,8 @@ class FeasibilityModel:
                  classifier: Classifier | None = None):
         """`classifier`: the prior of the narrow kernels (default: the wide kernel estimate)."""
         self.fraction_failed = float(failed.mean())
-        self.notes: dict[str, str] = {}  # what the planner records in proposal meta about this model (a fallback)
+        # what the planner records in proposal meta about this model: options that keep failing, a fallback
+        self.notes: dict[str, str] = {}
         self.prior = (len(failed) - failed.sum() + 1.0) / (len(failed) + 2.0)
         labels = failed.astype(float)
         self._wide = classifier if classifier is not None else WideKernels(space, X, labels, self.prior,
@@ -111,6 +125,9 @@ class FeasibilityModel:
         narrow = KernelDensity(space, X, labels, feasible_fraction, generator, descriptors=no_descriptors(space))
         self._narrow = (Acquisition(narrow, 0.0), Acquisition(narrow, 1.0))
         self.option_factors = option_factors(space, X, np.asarray(failed, dtype=bool), self.prior)
+        failing = failing_options(space, X, np.asarray(failed, dtype=bool), self.option_factors)
+        if failing:
+            self.notes["failing_options"] = failing
 
     def probability(self, X: np.ndarray) -> np.ndarray:
         """(M, D) internal points -> (M,) P(feasible): Gryffin's narrow kernels, each option on its own, with the

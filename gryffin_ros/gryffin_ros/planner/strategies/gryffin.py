@@ -180,7 +180,7 @@ class Planner(BasePlanner):
                 notes = {"feas_model": "kde", "feas_model_reason": str(error)}
         model = FeasibilityModel(self.space, observed, failed, self.feasible_fraction.value, generator, descriptors,
                                  classifier)
-        model.notes = notes
+        model.notes.update(notes)
         return model
 
     def _away_from_failures(self, n: int, rng: np.random.Generator, observed: np.ndarray, chosen: np.ndarray,
