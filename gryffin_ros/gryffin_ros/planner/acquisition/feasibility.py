@@ -58,33 +58,32 @@ def weight(p_feasible: np.ndarray, approach: str) -> np.ndarray:
     return p_feasible
 
 
-def option_factors(space: SearchSpace, X: np.ndarray, failed: np.ndarray, prior: float) -> dict[int, np.ndarray]:
-    """By finite dim of each categorical parameter with 2 to OPTION_MAX_OPTIONS options: the factor of each option on
-    P(feasible), min(1, r / prior), r the option's success rate among the experiments X with `prior` worth
-    OPTION_PRIOR_WEIGHT of them (none with a weight of 0)."""
-    out: dict[int, np.ndarray] = {}
+def option_counts(space: SearchSpace, X: np.ndarray, failed: np.ndarray) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """By dim of each categorical parameter with 2 to OPTION_MAX_OPTIONS options: the successful runs and all runs of
+    each option among the experiments X (none with OPTION_PRIOR_WEIGHT 0: the option factors are off)."""
     if OPTION_PRIOR_WEIGHT <= 0:
-        return out
+        return {}
+    out = {}
     for d in space.small_categorical_dims(OPTION_MAX_OPTIONS):
         options = np.rint(X[:, d]).astype(int)
-        runs = np.bincount(options, minlength=int(space.n_options[d]))
-        successes = np.bincount(options[~failed], minlength=int(space.n_options[d]))
-        rate = (successes + OPTION_PRIOR_WEIGHT * prior) / (runs + OPTION_PRIOR_WEIGHT)
-        out[d] = np.minimum(1.0, rate / prior)
+        out[d] = (np.bincount(options[~failed], minlength=int(space.n_options[d])),
+                  np.bincount(options, minlength=int(space.n_options[d])))
     return out
 
 
-def failing_options(space: SearchSpace, X: np.ndarray, failed: np.ndarray, factors: dict[int, np.ndarray]) -> str:
+def option_factors(counts: dict[int, tuple[np.ndarray, np.ndarray]], prior: float) -> dict[int, np.ndarray]:
+    """The factor of each option on P(feasible), min(1, r / prior), r the option's success rate with `prior` worth
+    OPTION_PRIOR_WEIGHT runs; `counts`: option_counts."""
+    return {d: np.minimum(1.0, (successes + OPTION_PRIOR_WEIGHT * prior) / (runs + OPTION_PRIOR_WEIGHT) / prior)
+            for d, (successes, runs) in counts.items()}
+
+
+def failing_options(space: SearchSpace, counts: dict[int, tuple[np.ndarray, np.ndarray]],
+                    factors: dict[int, np.ndarray]) -> str:
     """What a proposal's meta says of the options whose factor at least halves P: "base=Cs2CO3 (0 of 4 succeeded)",
     "; "-separated ("" for none)."""
-    out = []
-    for d, factor in factors.items():
-        options = np.rint(X[:, d]).astype(int)
-        for o in np.flatnonzero(factor <= 0.5):
-            runs = options == o
-            out.append(f"{space.names[d]}={space.parameters[d].options[o]} ({int((runs & ~failed).sum())} of "
-                       f"{int(runs.sum())} succeeded)")
-    return "; ".join(out)
+    return "; ".join(f"{space.names[d]}={space.parameters[d].options[o]} ({counts[d][0][o]} of {counts[d][1][o]} "
+                     "succeeded)" for d, factor in factors.items() for o in np.flatnonzero(factor <= 0.5))
 
 
 def no_descriptors(space: SearchSpace) -> dict[int, None]:
@@ -124,8 +123,9 @@ class FeasibilityModel:
                                                                            feasible_fraction, generator, descriptors)
         narrow = KernelDensity(space, X, labels, feasible_fraction, generator, descriptors=no_descriptors(space))
         self._narrow = (Acquisition(narrow, 0.0), Acquisition(narrow, 1.0))
-        self.option_factors = option_factors(space, X, np.asarray(failed, dtype=bool), self.prior)
-        failing = failing_options(space, X, np.asarray(failed, dtype=bool), self.option_factors)
+        counts = option_counts(space, X, np.asarray(failed, dtype=bool))
+        self.option_factors = option_factors(counts, self.prior)
+        failing = failing_options(space, counts, self.option_factors)
         if failing:
             self.notes["failing_options"] = failing
 
