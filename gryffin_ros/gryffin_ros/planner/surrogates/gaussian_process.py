@@ -56,8 +56,12 @@ CHUNK = 4096
 FIT_MAX, FIT_BEST = 300, 100
 # Above COND_MAX observations the GP is conditioned on COND_MAX of them: the COND_BEST best by merit (the incumbent
 # and where the acquisition works) and a seeded random draw of the rest, new each ask. Exact conditioning costs n^3
-# for the Cholesky factor and (M, n) per candidate batch: a warm ask took 9.5 s at n = 5000 on 2 cores.
-COND_MAX, COND_BEST = 1000, 300
+# for the Cholesky factor and (M, n) per candidate batch: a warm ask took 9.5 s at n = 5000 on 2 cores. Without known
+# constraints (Adam then runs all its steps) a warm ask at n = 1000, d = 10 took 0.89-0.92 s conditioned on all
+# 1000, 0.55-0.60 s on 700 and 0.33-0.42 s on 500; over 9 seeds the values of the next 10 proposals were the same
+# on 700 as on 1000 (best -5.08 and -5.08, mean -4.46 and -4.50), worse on 500 (-4.80, -4.39). benchmarks/README.md,
+# "Lab-scale ask times", round three.
+COND_MAX, COND_BEST = 700, 300
 # The marginal likelihood has a second optimum that explains the data as noise around a constant (output scale at its
 # floor, long length scales); fits from BoTorch's start (the middle of the bounds: length scales 10, output scale 50)
 # ended there on 8 random points of a smooth 3-D bowl and on m_coupling's seed 2 after 15 and 25 results, and such a
