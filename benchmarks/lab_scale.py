@@ -236,8 +236,8 @@ def main() -> None:
     torch.set_num_threads(1)
     label = a.surrogate or "default"
 
-    cases = {"warm": case_warm, "warm_free": case_warm_free, "batch8": case_batch8, "batch96": case_batch96, "stateless": case_stateless,
-             "mixed": case_mixed}
+    cases = {"warm": case_warm, "warm_free": case_warm_free, "batch8": case_batch8, "batch96": case_batch96,
+             "stateless": case_stateless, "mixed": case_mixed}
     rows: list = []
     notes: list = []
     for name in a.cases.split(","):
