@@ -65,10 +65,12 @@ def objective(x: np.ndarray) -> float:
 
 
 def feasible_points(m: int, d: int, rng: np.random.Generator, constrained: bool = True) -> np.ndarray:
+    if not constrained:
+        return rng.random((m, d))
     out = []
     while len(out) < m:
         x = rng.random((4 * m, d))
-        keep = (x.sum(1) <= 0.6 * d) & (((x - 0.5) ** 2).sum(1) >= 0.04) if constrained else np.ones(len(x), bool)
+        keep = (x.sum(1) <= 0.6 * d) & (((x - 0.5) ** 2).sum(1) >= 0.04)
         out.extend(x[keep])
     return np.array(out[:m])
 
