@@ -71,6 +71,11 @@ class SearchSpace:
         """Log of the domain volume in internal units: 1 per continuous dim, the option count per finite dim."""
         return float(np.log(self.n_options).sum())
 
+    def option_tally(self, X: np.ndarray, d: int) -> np.ndarray:
+        """How many of the internal points X (M, D) hold each option of finite dim d: (n_options[d],)."""
+        options = np.rint(np.asarray(X, dtype=float).reshape(-1, self.dim)[:, d]).astype(int)
+        return np.bincount(options, minlength=int(self.n_options[d]))
+
     def small_categorical_dims(self, max_options: int) -> list[int]:
         """The dims of the categorical parameters with 2 to `max_options` options: few enough that each option gets
         runs of its own in a campaign."""

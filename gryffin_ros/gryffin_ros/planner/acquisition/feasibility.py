@@ -65,9 +65,7 @@ def option_counts(space: SearchSpace, X: np.ndarray, failed: np.ndarray) -> dict
         return {}
     out = {}
     for d in space.small_categorical_dims(OPTION_MAX_OPTIONS):
-        options = np.rint(X[:, d]).astype(int)
-        out[d] = (np.bincount(options[~failed], minlength=int(space.n_options[d])),
-                  np.bincount(options, minlength=int(space.n_options[d])))
+        out[d] = (space.option_tally(X[~failed], d), space.option_tally(X, d))
     return out
 
 

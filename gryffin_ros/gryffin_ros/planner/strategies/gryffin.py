@@ -377,9 +377,7 @@ class Planner(BasePlanner):
         COVER_TRIES of `points` (observed and pending experiments, internal units) hold."""
         out = []
         for d in self.space.small_categorical_dims(COVER_MAX_OPTIONS):
-            counts = np.bincount(np.rint(points[:, d]).astype(int), minlength=int(self.space.n_options[d])) \
-                if len(points) else np.zeros(int(self.space.n_options[d]), dtype=int)
-            out += [(d, int(o)) for o in np.flatnonzero(counts < COVER_TRIES)]
+            out += [(d, int(o)) for o in np.flatnonzero(self.space.option_tally(points, d) < COVER_TRIES)]
         return out
 
     def _covering_candidates(self, acquisition: AcquisitionFunction, under: list[tuple[int, int]],
