@@ -1,5 +1,5 @@
-"""The constrained acquisition optimizers: Adam's steps stay feasible (projected onto linear constraints, shortened or
-sliding along other boundaries), Hill keeps feasibility, the genetic optimizer projects infeasible children onto the
+"""The constrained acquisition optimizers: Adam's steps are projected onto linear constraints and stop at the last
+feasible point of others, Hill keeps feasibility, the genetic optimizer projects infeasible children onto the
 boundary."""
 
 import numpy as np
@@ -22,8 +22,9 @@ def acquisition_pulling_to(space, best, strategy=1.0):
     return Acquisition(density, strategy)
 
 
-def test_adam_stops_at_the_last_feasible_position():
-    constraints = KnownConstraints.build(SQUARE, ["x0 < 0.5"])
+def test_adam_stops_at_the_last_feasible_position_of_a_nonlinear_constraint():
+    constraints = KnownConstraints.build(SQUARE, ["x0 ** 2 < 0.25"])  # x0 < 0.5, but not linear: no projection
+    assert constraints.halfspaces() is None
     acquisition = acquisition_pulling_to(SQUARE, [0.56, 0.5])
     start = np.array([[0.49, 0.5], [0.45, 0.52], [0.3, 0.5]])
     refined, alpha = AdamHillOptimizer(constraints, steps=30).optimize(acquisition, start, np.random.default_rng(0))
@@ -45,42 +46,15 @@ def test_adam_slides_along_a_linear_boundary_towards_the_constrained_optimum():
     assert np.allclose(alpha, acquisition.evaluate(refined))
 
 
-def test_adam_moves_the_dims_that_can_move_alone_at_a_nonlinear_boundary():
-    # x1 <= 0.5 + 0.1 x0^2 is not linear: no projection; from the boundary, the step towards (0.5, 0.7) leaves the
-    # set at any length, but its x0 part alone stays inside (and raises the boundary for x1)
-    constraints = KnownConstraints.build(SQUARE, ["x1 <= 0.5 + 0.1 * x0 ** 2"])
-    assert constraints.halfspaces() is None
-    acquisition = acquisition_pulling_to(SQUARE, [0.5, 0.7])
-    start = np.array([[0.3, 0.5089]])
+def test_a_projected_step_that_breaks_a_nonlinear_constraint_is_not_taken():
+    # along x0 + x1 = 1 towards (0.6, 0.4), the centre of a keep-out disc on the line: the point slides up to the disc
+    constraints = KnownConstraints.build(SQUARE, ["x0 + x1 <= 1", "(x0 - 0.6) ** 2 + (x1 - 0.4) ** 2 >= 0.01"])
+    acquisition = acquisition_pulling_to(SQUARE, [0.7, 0.5])
+    start = np.array([[0.4, 0.6]])
     refined, alpha = AdamHillOptimizer(constraints, steps=30).optimize(acquisition, start, np.random.default_rng(0))
     assert constraints.feasible(refined).all()
-    assert refined[0, 0] > 0.4 and refined[0, 1] > 0.515  # up the boundary (0.5 + 0.1 * 0.4^2 = 0.516)
-    assert alpha[0] < acquisition.evaluate(start)[0]
-
-
-def test_hill_moves_go_on_for_a_point_whose_adam_step_is_blocked():
-    space = SearchSpace.from_config([{"name": "x", "type": "continuous", "low": 0, "high": 1},
-                                     {"name": "c", "type": "categorical", "options": ["a", "b"]}])
-    constraints = KnownConstraints.build(space, ["x <= 0.5"])
-    X = np.array([[0.6, 1.0], [0.1, 0.0], [0.9, 0.0]])  # the best observation: option b, beyond the boundary in x
-    density = KernelDensity(space, X, np.array([0.0, 1.0, 1.0]), 1.0, torch.Generator().manual_seed(0))
-    acquisition = Acquisition(density, 1.0)
-    start = np.array([[0.5, 0.0]])  # at the boundary in its one continuous dim, with the poorer option
-    assert acquisition.evaluate(np.array([[0.5, 1.0]]))[0] < acquisition.evaluate(start)[0]
-    refined, alpha = AdamHillOptimizer(constraints).optimize(acquisition, start, np.random.default_rng(0))
-    assert refined[0, 1] == 1.0
-    assert constraints.feasible(refined).all() and np.allclose(alpha, acquisition.evaluate(refined))
-
-
-def test_a_blocked_step_across_a_periodic_boundary_stays_short():
-    space = SearchSpace.from_config([{"name": "angle", "type": "continuous", "low": 0, "high": 1, "periodic": True},
-                                     {"name": "x", "type": "continuous", "low": 0, "high": 1}])
-    constraints = KnownConstraints.build(space, ["x <= 0.5"])
-    X = np.array([[0.995, 0.5]])
-    moved, ok = AdamHillOptimizer(constraints).feasible_step(X, np.array([[0.01, 0.01]]))
-    # x cannot grow; the angle's part of the step alone wraps to 0.005 (not half-way round, as a step measured
-    # between the wrapped point and the start would be)
-    assert ok.all() and np.allclose(moved, [[0.005, 0.5]])
+    assert refined[0].sum() > 0.99 and refined[0, 0] > 0.45  # on the line, and moved along it
+    assert np.allclose(alpha, acquisition.evaluate(refined))
 
 
 def test_adam_improves_the_acquisition_without_constraints_binding():
