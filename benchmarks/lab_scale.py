@@ -2,8 +2,8 @@
 
 - warm asks around n = 1000 observations, d = 10 (the median of 10 consecutive asks, n = 996 ... 1005, and the
   slowest of them), and the first ask of a fresh planner on 995 observations; `warm_free`: the same without the known
-  constraints (near the constrained optimum most of Adam's steps leave the feasible set and end there, so the
-  unconstrained ask does more work);
+  constraints (the constrained optimum lies on the linear one, where Adam's steps are projected back onto it, and
+  the nonlinear one would stop them; without constraints every step is taken as it is);
 - a batch of 8 at n = 200, d = 6;
 - a batch of 96 (a well plate) at n = 500, d = 6, and how spread out it is: the smallest pairwise distance of its
   points (unit cube) against that of 96 random feasible points (median over 20 draws);
