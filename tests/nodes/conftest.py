@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -171,6 +172,7 @@ def lab_session():
 def node_env(tmp_path: Path) -> dict[str, str]:
     env = ros_environment()
     env["ROS_LOG_DIR"] = str(tmp_path / "ros_logs")
+    env["PYTHONFAULTHANDLER"] = "1"  # a node that crashes, or is sent SIGABRT, prints every thread's stack
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(PLUGIN_PATH), env.get("PYTHONPATH")]))
     return env
 
@@ -226,8 +228,34 @@ def pytest_runtest_makereport(item, call):
     report = outcome.get_result()
     if report.failed:
         for process in getattr(item, "planner_processes", []):
-            report.sections.append((f"planner node output ({process.log_path.name}, last 60 lines)",
-                                    "\n".join(process.output().splitlines()[-60:])))
+            report.sections.append((f"planner node output ({process.log_path.name}, last 200 lines)",
+                                    "\n".join(process.output().splitlines()[-200:])))
+
+
+def why_unanswered(session: Client, planner: PlannerProcess, statuses_before: int, tmp_path: Path) -> str:
+    """What to say when a planner never answered this test process: whether DDS works from the planner to this
+    process (its latched status arrived after `statuses_before` of them), from this process to it (the JSON bridge's
+    ~/json/get_status, another client of this process's participant), and from a new process; then the planner is
+    sent SIGABRT, so its output (in the failure's report) ends with the stack of each of its threads."""
+    with session.lock:
+        statuses = len(session.statuses) - statuses_before
+    future = session.status_client.call_async(Trigger.Request())
+    deadline = time.monotonic() + QUERY_RESEND_S
+    while not future.done() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    bridge = "answered" if future.done() else "no answer"
+    if not future.done():
+        session.status_client.remove_pending_request(future)
+    probe = subprocess.run([sys.executable, "-m", "tests.nodes.probe_status", "/gryffin_planner", "30"],
+                           cwd=Path(__file__).resolve().parents[2], env=node_env(tmp_path), capture_output=True,
+                           text=True, timeout=HANG_S)
+    alive = planner.process.poll() is None
+    if alive:
+        planner.process.send_signal(signal.SIGABRT)
+        planner.process.wait(timeout=HANG_S)
+    return (f"planner {'running' if alive else f'exited ({planner.process.returncode})'}; its latched status reached "
+            f"this process {statuses} time(s) since the restart; ~/json/get_status from this process: {bridge}; "
+            f"~/get_status from a new process: {(probe.stdout.strip() or probe.stderr[-500:])}")
 
 
 @pytest.fixture

@@ -59,8 +59,7 @@ def test_sigkilled_planner_resumes_without_losing_or_repeating_anything(client, 
             acknowledged |= {e["experiment_id"] for e in client.events if e["type"] == "observation_accepted"}
     finally:
         held |= fastdds_shm.held_by(emulator.pid)
-        emulator.kill()
-        emulator.wait()
+        supervisor.stop()
     observed, proposed = stored(store)
     assert acknowledged and acknowledged <= set(observed), "an acknowledged observation was lost"
     assert len(observed) == len(set(observed))

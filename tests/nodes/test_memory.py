@@ -38,13 +38,12 @@ def wait_for(path: Path, count: int) -> None:
 def test_planner_memory_stays_flat_over_hundreds_of_asks(start_planner, supervisor, tmp_path):
     store = tmp_path / "memory.sqlite"
     planner = start_planner(storage=str(store), batch_size=10)
-    emulator = start_emulator(supervisor, tmp_path, "-p", "seed:=1", "-p", "objectives:=[X1_X2]")
+    start_emulator(supervisor, tmp_path, "-p", "seed:=1", "-p", "objectives:=[X1_X2]")
     try:
         wait_for(store, 100)
         early = rss_mb(planner.process.pid)
         wait_for(store, 400)
         late = rss_mb(planner.process.pid)
     finally:
-        emulator.kill()
-        emulator.wait()
+        supervisor.stop()
     assert late - early < GROWTH_LIMIT_MB, f"planner node grew from {early:.0f} MB to {late:.0f} MB"

@@ -31,7 +31,7 @@ from rclpy.qos import qos_profile_system_default
 from gryffin_ros.nodes.qos import EVENTS_QOS, OBSERVATIONS_QOS
 from gryffin_ros.paths import share_path
 
-from .conftest import FLOW_CONFIG, HANG_S, flow_feasible, node_env, query, spinning, start_emulator
+from .conftest import FLOW_CONFIG, HANG_S, flow_feasible, node_env, query, spinning, start_emulator, why_unanswered
 
 EXAMPLES = share_path("examples")
 # client rule (docs/ros.md): a goal not accepted within this long is sent again under the same instrument name; a
@@ -359,9 +359,7 @@ def test_two_campaigns_in_two_namespaces_do_not_cross(start_planner, supervisor,
                                             "objectives:=[X1_X2]"))
         wait_until(lambda: all(len(stored_ids(s)[0]) >= 4 for s in stores.values()), "4 experiments in each lab")
     finally:
-        for emulator in emulators:
-            emulator.kill()
-            emulator.wait()
+        supervisor.stop()  # the emulators, by SIGINT (a SIGKILLed participant can stall the others: Fast-DDS#5469)
     (observed1, proposed1, rejected1), (observed2, proposed2, rejected2) = (stored_ids(s) for s in stores.values())
     assert observed1 <= proposed1 and observed2 <= proposed2
     assert not proposed1 & proposed2
@@ -389,13 +387,14 @@ def test_the_readme_typed_client_runs_as_written(start_planner, tmp_path):
     try:
         wait_until(lambda: client.poll() is not None or len(stored_ids(store)[0]) == 2, "the README client's results")
     finally:
-        client.kill()
-        output = client.communicate()[0]
+        client.send_signal(signal.SIGINT)  # not SIGKILL (eProsima/Fast-DDS#5469: it can stall the other processes)
+        output = client.communicate(timeout=HANG_S)[0]
     assert len(stored_ids(store)[0]) == 2, output
     assert "optimizing" in output or "models" in output  # the feedback stages it prints
 
 
-def test_after_a_restart_a_client_that_retries_gets_the_experiment_still_owed(lab, start_planner, tmp_path):
+def test_after_a_restart_a_client_that_retries_gets_the_experiment_still_owed(lab, lab_session, start_planner,
+                                                                             tmp_path):
     """A killed node's services and action still look available to DDS for a while, so a request can go to the dead
     node; the documented client rule: probe ~/get_status with a timeout, retry until it answers, then send goals."""
     store = tmp_path / "restart.sqlite"
@@ -403,11 +402,15 @@ def test_after_a_restart_a_client_that_retries_gets_the_experiment_still_owed(la
     (owed,) = lab.recommend_now(1).result.proposals
     planner.process.kill()
     planner.process.wait()
-    start_planner(storage=str(store), auto_propose=False, wait=False)
-    attempts = 0
+    with lab_session.lock:
+        statuses = len(lab_session.statuses)
+    restarted = start_planner(storage=str(store), auto_propose=False, wait=False)
+    # a restarted node answers within seconds; once, in a full `make test`, it never did (400 s; cause unknown):
+    # the failure then says which direction of DDS still worked
+    give_up = time.monotonic() + HANG_S
     while True:
-        attempts += 1
-        assert attempts < 200, "the restarted planner never answered"
+        assert time.monotonic() < give_up, (
+            f"the restarted planner never answered: {why_unanswered(lab_session, restarted, statuses, tmp_path)}")
         if not lab.get_status.wait_for_service(timeout_sec=1.0):
             continue
         future = lab.get_status.call_async(GetStatus.Request())
