@@ -246,16 +246,20 @@ def why_unanswered(session: Client, planner: PlannerProcess, statuses_before: in
     bridge = "answered" if future.done() else "no answer"
     if not future.done():
         session.status_client.remove_pending_request(future)
-    probe = subprocess.run([sys.executable, "-m", "tests.nodes.probe_status", "/gryffin_planner", "30"],
-                           cwd=Path(__file__).resolve().parents[2], env=node_env(tmp_path), capture_output=True,
-                           text=True, timeout=HANG_S)
+    try:
+        probe = subprocess.run([sys.executable, "-m", "tests.nodes.probe_status", "/gryffin_planner", "30"],
+                               cwd=Path(__file__).resolve().parents[2], env=node_env(tmp_path), capture_output=True,
+                               text=True, timeout=HANG_S)
+        fresh = probe.stdout.strip() or probe.stderr[-500:]
+    except subprocess.TimeoutExpired:
+        fresh = f"the probe itself hung for {HANG_S:.0f} s"
     alive = planner.process.poll() is None
     if alive:
         planner.process.send_signal(signal.SIGABRT)
         planner.process.wait(timeout=HANG_S)
     return (f"planner {'running' if alive else f'exited ({planner.process.returncode})'}; its latched status reached "
             f"this process {statuses} time(s) since the restart; ~/json/get_status from this process: {bridge}; "
-            f"~/get_status from a new process: {(probe.stdout.strip() or probe.stderr[-500:])}")
+            f"~/get_status from a new process: {fresh}")
 
 
 @pytest.fixture
