@@ -78,6 +78,43 @@ def test_descriptor_columns_of_categorical_parameters_keep_a_length_scale_floor(
     assert lengthscale[2] >= floor * (1 - 1e-9)
     assert lengthscale[2] < 2 * floor  # the data push it down to the floor: a floor that holds, not an idle one
 
+
+def test_with_two_described_categorical_parameters_the_kernel_adds_each_one_s_main_effect():
+    """Ligand and solvent with descriptors far apart (one-hot: the descriptors tell nothing), yield = ligand's effect
+    + solvent's effect + a little of t. Ligand c and solvent c are each the best, seen only with other partners. The
+    main-effect terms predict the untried c/c as the best combination, better than anything run; one product kernel
+    (what the GP had before) cannot: c/c correlates with nothing it has seen, and it predicts c/c at about the mean."""
+    options = ["a", "b", "c", "d", "e"]
+    onehot = {o: [float(i == j) for j in range(5)] for i, o in enumerate(options)}
+    space = SearchSpace.from_config([
+        {"name": "t", "type": "continuous", "low": 0, "high": 1},
+        {"name": "n", "type": "discrete", "options": [1, 2, 3]},
+        {"name": "ligand", "type": "categorical", "options": options, "descriptors": onehot},
+        {"name": "solvent", "type": "categorical", "options": options, "descriptors": onehot}])
+    features = Features(space)
+    # t, n (a discrete parameter: its ordinal position, not a group), then the two groups of five columns
+    assert features.described_groups() == [[2, 3, 4, 5, 6], [7, 8, 9, 10, 11]]
+    ligand = {"a": 0.0, "b": 0.6, "c": -1.0, "d": 0.8, "e": 0.3}
+    solvent = {"a": 0.5, "b": -0.2, "c": -1.0, "d": 0.9, "e": 0.0}
+    pairs = [(a, b) for a in options for b in options if (a, b) != ("c", "c")]
+    grid = space.to_internal([{"t": 0.5, "n": 2, "ligand": a, "solvent": b} for a in options for b in options])
+    best_pair = options.index("c") * 5 + options.index("c")
+    for seed in range(3):
+        rng = np.random.default_rng(seed)
+        params = [{"t": float(rng.random()), "n": int(rng.choice([1, 2, 3])), "ligand": a, "solvent": b}
+                  for a, b in (pairs[i] for i in rng.permutation(len(pairs))[:14])]
+        y = np.array([ligand[p["ligand"]] + solvent[p["solvent"]] + 0.5 * (p["t"] - 0.5) ** 2 for p in params])
+        gp = GaussianProcess(space, space.to_internal(params), y, seed=0)
+        assert len(gp.model.covar_module.kernels) == 3  # every interaction, the ligand's and the solvent's effect
+        mean = gp.model.posterior(gp.features.of(grid)).mean.detach().numpy().ravel()
+        assert int(np.argmin(mean)) == best_pair and mean[best_pair] < y.min()  # true value -2.0
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(gp_module, "MAIN_EFFECTS_MIN_PARAMETERS", 3)  # one product kernel over every input
+            product = GaussianProcess(space, space.to_internal(params), y, seed=0)
+            mean = product.model.posterior(product.features.of(grid)).mean.detach().numpy().ravel()
+            assert int(np.argmin(mean)) != best_pair and mean[best_pair] > y.min()
+
+
 def test_a_space_of_categorical_options_without_descriptors_fits_and_recommends():
     """Only options, no descriptors: no input has a Matern length scale (no floors at all), and the GP still fits,
     predicts the options it has seen in order, and recommends (an empty per-input bound once broke every ask of the
