@@ -93,7 +93,7 @@ def test_with_two_described_categorical_parameters_the_kernel_adds_each_one_s_ma
         {"name": "solvent", "type": "categorical", "options": options, "descriptors": onehot}])
     features = Features(space)
     # t, n (a discrete parameter: its ordinal position, not a group), then the two groups of five columns
-    assert features.described_groups() == [[2, 3, 4, 5, 6], [7, 8, 9, 10, 11]]
+    assert features.described_groups == [[2, 3, 4, 5, 6], [7, 8, 9, 10, 11]]
     ligand = {"a": 0.0, "b": 0.6, "c": -1.0, "d": 0.8, "e": 0.3}
     solvent = {"a": 0.5, "b": -0.2, "c": -1.0, "d": 0.9, "e": 0.0}
     pairs = [(a, b) for a in options for b in options if (a, b) != ("c", "c")]

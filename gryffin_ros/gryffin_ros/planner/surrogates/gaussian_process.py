@@ -136,25 +136,18 @@ class Features:
         self.dim = int(offsets[-1])
         self.cat_dims = [int(offsets[i]) for i, (kind, _, _) in enumerate(self.columns) if kind == "category"]
         # the least length scale of each input that a Matern kernel sees (all but the categorical ones), in order,
-        # and which of those inputs have the length-scale prior (all but a discrete parameter's ordinal positions)
-        floors, prior = [], []
-        for (kind, j, _), width in zip(self.columns, parts):
+        # which of those inputs have the length-scale prior (all but a discrete parameter's ordinal positions), and
+        # the inputs of each categorical parameter with descriptors, one list per parameter (`main_effects_kernel`)
+        floors, prior, self.described_groups = [], [], []
+        for (kind, j, _), width, offset in zip(self.columns, parts, offsets):
             if kind != "category":
                 described = kind == "table" and space.parameters[int(space.finite_idx[j])].kind == "categorical"
                 floors += [DESCRIPTOR_LENGTHSCALE_MIN if described else LENGTHSCALE_BOUNDS[0]] * width
                 prior += [kind != "table" or described] * width
+                if described:
+                    self.described_groups.append(list(range(int(offset), int(offset) + width)))
         self.lengthscale_floors = torch.as_tensor(floors, dtype=DTYPE)
         self.prior_inputs = [i for i, p in enumerate(prior) if p]
-
-    def described_groups(self) -> list[list[int]]:
-        """The input columns of each categorical parameter with descriptors, one list per parameter, in order."""
-        groups, offset = [], 0
-        for kind, j, table in self.columns:
-            width = 1 if kind in ("continuous", "category") else (2 if kind == "periodic" else table.shape[1])
-            if kind == "table" and self.space.parameters[int(self.space.finite_idx[j])].kind == "categorical":
-                groups.append(list(range(offset, offset + width)))
-            offset += width
-        return groups
 
     def __call__(self, xc: torch.Tensor, xf: torch.Tensor) -> torch.Tensor:
         """xc: (M, C) continuous coordinates (may require grad), xf: (M, F) long option indices -> (M, G)."""
@@ -233,9 +226,8 @@ class GaussianProcess:
             self.model = MixedSingleTaskGP(train_X, train_Y, cat_dims=self.features.cat_dims, likelihood=likelihood,
                                            cont_kernel_factory=matern, outcome_transform=Standardize(m=1))
         else:
-            groups = self.features.described_groups()
-            if len(groups) >= MAIN_EFFECTS_MIN_PARAMETERS:
-                covar = main_effects_kernel(self.features, groups)
+            if len(self.features.described_groups) >= MAIN_EFFECTS_MIN_PARAMETERS:
+                covar = main_effects_kernel(self.features)
             else:
                 covar = ScaleKernel(matern(ard_num_dims=self.features.dim),
                                     outputscale_constraint=Interval(*OUTPUTSCALE_BOUNDS))
@@ -330,11 +322,13 @@ def matern_kernel(bounds, prior_inputs: list[int], ard_num_dims: int, batch_shap
     return kernel
 
 
-def main_effects_kernel(features: Features, groups: list[list[int]]) -> AdditiveKernel:
-    """Every interaction (a scaled ARD Matern over every input) plus, for each group of descriptor columns (one
-    categorical parameter's), a scaled ARD Matern over that group and the inputs outside every group: the parameter's
-    main effect, shared by every combination of the other categorical parameters (MAIN_EFFECTS_MIN_PARAMETERS). Each
-    term keeps the inputs' length-scale floors, bounds and prior."""
+def main_effects_kernel(features: Features) -> AdditiveKernel:
+    """Every interaction (a scaled ARD Matern over every input) plus, for each categorical parameter with descriptors
+    (`features.described_groups`), a scaled ARD Matern over its descriptor columns and the inputs outside every such
+    group: the parameter's main effect, shared by every combination of the other categorical parameters
+    (MAIN_EFFECTS_MIN_PARAMETERS). Each term keeps the inputs' length-scale floors, bounds and prior; for spaces
+    without category inputs (every input has a floor)."""
+    groups = features.described_groups
     described = {i for g in groups for i in g}
     rest = [i for i in range(features.dim) if i not in described]
     floors = features.lengthscale_floors
