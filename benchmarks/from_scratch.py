@@ -20,6 +20,7 @@ import argparse
 import os
 import statistics
 import sys
+from collections.abc import Callable
 from multiprocessing import Pool
 from pathlib import Path
 
@@ -43,18 +44,16 @@ def hidden_failure(task, x: list) -> bool:
     return task.bases[int(x[1])] == "Cs2CO3" or (task.solvents[int(x[2])] == "DMF" and x[3] > 110.0)
 
 
-def run(job: tuple[str, int, bool, int | None, float]) -> tuple[str, int, int, int, float]:
-    """One campaign: (task, seed, hidden failures, budget or the task's, rate of random failures) -> (task, seed,
-    failed experiments, failed in the budget's second half, best successful value)."""
+def campaign(task, seed: int, budget: int, fails: Callable[[int, list], bool]) -> tuple[int, int, float]:
+    """One campaign of a harness task from the planner's first proposal (the default config, the task's constraint as
+    the known constraint); `fails(experiment, x)` says whether experiment number `experiment` (from 1) at the harness
+    point x fails (reported as None) -> (failed experiments, failed in the budget's second half, best successful
+    value)."""
     import torch
 
     from benchmarks.peers.gryffin_ros_peer import config, from_planner, option_names_of, to_planner
     from gryffin_ros.planner import Planner
     torch.set_num_threads(1)
-    name, seed, hidden, budget, failure_rate = job
-    task = portfolio_tasks.TASKS[name]()
-    budget = budget or task.budget
-    at_random = failure_draws(seed, failure_rate, budget)
     names = option_names_of(task, seed)
     index = {n: {o: i for i, o in enumerate(options)} for n, options in names.items()}
     planner = Planner(config(task, None, False, names), seed=seed,
@@ -63,13 +62,26 @@ def run(job: tuple[str, int, bool, int | None, float]) -> tuple[str, int, int, i
     for experiment in range(1, budget + 1):
         (proposal,) = planner.ask()
         x = from_planner(task, proposal.params, index)
-        fails = (hidden and hidden_failure(task, x)) or at_random[experiment - 1]
-        failed += fails
-        late += fails and experiment > budget // 2
-        y = None if fails else float(task.objective(x))
+        failing = fails(experiment, x)
+        failed += failing
+        late += failing and experiment > budget // 2
+        y = None if failing else float(task.objective(x))
         best = best if y is None else min(best, y)
         planner.tell({**to_planner(task, x, names), "y": y, "experiment_id": proposal.experiment_id})
-    return name, seed, failed, late, best
+    return failed, late, best
+
+
+def run(job: tuple[str, int, bool, int | None, float]) -> tuple[str, int, int, int, float]:
+    """One campaign: (task, seed, hidden failures, budget or the task's, rate of random failures) -> (task, seed,
+    failed experiments, failed in the budget's second half, best successful value)."""
+    name, seed, hidden, budget, failure_rate = job
+    task = portfolio_tasks.TASKS[name]()
+    budget = budget or task.budget
+    at_random = failure_draws(seed, failure_rate, budget)
+    def fails(experiment: int, x: list) -> bool:
+        return (hidden and hidden_failure(task, x)) or at_random[experiment - 1]
+
+    return (name, seed, *campaign(task, seed, budget, fails))
 
 
 def main() -> None:

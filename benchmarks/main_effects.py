@@ -30,6 +30,7 @@ sys.path.insert(0, os.environ.get("PEERS_DIR", str(ROOT.parent / "shared" / "pee
 
 from problems import CatParam, Param, Task  # noqa: E402
 
+from benchmarks.from_scratch import campaign  # noqa: E402
 from gryffin_ros.planner.surrogates.gaussian_process import MAIN_EFFECTS_MIN_PARAMETERS  # noqa: E402
 
 CATALYSTS = {"c0": (0.1, 0.9), "c1": (0.4, 0.2), "c2": (0.8, 0.6), "c3": (0.95, 0.05), "c4": (0.3, 0.5)}
@@ -89,28 +90,12 @@ def reference(task: ThreeOptions, steps: int = 41) -> float:
 
 def run(job: tuple[str, int, bool]) -> tuple[str, int, bool, float]:
     """One campaign: (task, seed, main effects) -> the same and the best value."""
-    import torch
-
-    from benchmarks.peers.gryffin_ros_peer import config, from_planner, option_names_of, to_planner
-    from gryffin_ros.planner import Planner
     from gryffin_ros.planner.surrogates import gaussian_process
-    torch.set_num_threads(1)
     name, seed, main_effects = job
     # as shipped, or above the three parameters: one product kernel
     gaussian_process.MAIN_EFFECTS_MIN_PARAMETERS = MAIN_EFFECTS_MIN_PARAMETERS if main_effects else 4
     task = TASKS[name]()
-    names = option_names_of(task, seed)
-    index = {n: {o: i for i, o in enumerate(options)} for n, options in names.items()}
-    planner = Planner(config(task, None, False, names), seed=seed,
-                      known_constraints=lambda params: task.feasible(from_planner(task, params, index)))
-    best = math.inf
-    for _ in range(task.budget):
-        (proposal,) = planner.ask()
-        x = from_planner(task, proposal.params, index)
-        y = float(task.objective(x))
-        best = min(best, y)
-        planner.tell({**to_planner(task, x, names), "y": y, "experiment_id": proposal.experiment_id})
-    return name, seed, main_effects, best
+    return name, seed, main_effects, campaign(task, seed, task.budget, lambda experiment, x: False)[2]
 
 
 def main() -> None:
