@@ -173,7 +173,8 @@ def test_gp_planner_finds_the_constrained_branin_minimum():
     assert len(made) == 40 and all(branin_feasible(p.params) for p in made)
     assert planner.best().objectives["y"] - 0.397887 < 0.01  # the kernel density needs ~100 for 0.4
     assert made[0].meta == {} and [p.meta["surrogate"] for p in made[1:5]] == ["random"] * 4
-    assert all(p.meta == {"surrogate": "gp"} for p in made[5:])
+    # after 8 experiments without improvement an ask says it stalled (strategies/stall.py)
+    assert all(p.meta["surrogate"] == "gp" and set(p.meta) <= {"surrogate", "stalled"} for p in made[5:])
 
 
 def test_gp_batches_and_pending_experiments_are_spread_out():

@@ -25,6 +25,7 @@ from ..surrogates.kernel_density import KernelDensity
 from .base import BasePlanner
 from .feasible import SPREAD_SEEDS
 from .selection import apart, batch_spacing, select
+from .stall import STALL_WINDOW, exploring_until, stall
 
 if TYPE_CHECKING:  # the GP modules (and BoTorch, ~0.4 s to import) are loaded only by planners that use a GP
     from ..acquisition import AcquisitionFunction
@@ -260,11 +261,25 @@ class Planner(BasePlanner):
         report("optimizing", 0.0)
         start, exhaustive = self.start_points(rng, X[int(np.argmin(merits))], X)
         if gp is not None:
+            self._after_stall(gp, meta)
             points, covered = self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen)
             if covered:
                 meta["covering"] = f"options run fewer than {COVER_TRIES} times first: {', '.join(covered)}"
             return points, [None] * n, meta
         return (*self._propose_kde(n, rng, density, start, exhaustive, feasibility, observed, chosen), meta)
+
+    def _after_stall(self, gp: GaussianProcess, meta: dict[str, Any]) -> None:
+        """When the campaign has stalled (`stall`), the GP of this ask predicts what has not been tried at the
+        results' mean; the proposals' meta say so."""
+        _, values = self.successful_values()
+        merits = np.full(len(self.observations), np.nan)
+        merits[[not o.failed for o in self.observations]] = self.merits_of_values(values, transform=False)
+        covered = self.observed_points()[:, self.space.small_categorical_dims(COVER_MAX_OPTIONS)]
+        share = stall(merits, since=exploring_until(covered, COVER_TRIES))
+        if share is not None:
+            gp.at_results_mean()
+            meta["stalled"] = (f"the last {STALL_WINDOW} experiments improved the best result by {100 * share:.2g} % "
+                               "of the results' range: untried regions predicted at the results' mean")
 
     def _propose_kde(self, n: int, rng: np.random.Generator, density: KernelDensity, start: np.ndarray,
                      exhaustive: bool, feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray

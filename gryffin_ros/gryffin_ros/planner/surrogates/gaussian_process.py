@@ -293,6 +293,14 @@ class GaussianProcess:
             alpha = K_inv @ (y - post.mean(X))
             return (y - alpha / torch.diagonal(K_inv)).numpy()
 
+    def at_results_mean(self) -> None:
+        """Put the prior mean at the mean of the results (0 in standardized units) instead of its fitted constant,
+        which sits on the plateau where most results lie when most are poor: untried regions are then predicted at
+        the average result (`strategies.stall`). Before any point is believed."""
+        with torch.no_grad():
+            self.model.mean_module.constant = torch.zeros_like(self.model.mean_module.constant)
+        self._posterior = None
+
     def believe(self, X: np.ndarray, incumbent: bool = True) -> None:
         """Kriging believer: condition the GP on its own posterior mean at points whose results are not known yet
         (pending experiments, earlier proposals of this batch), so they are not proposed again. `incumbent=False` for

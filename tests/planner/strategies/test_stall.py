@@ -1,0 +1,106 @@
+"""Stalled campaigns: the rule that says when, and the GP ask that follows (untried regions at the results' mean)."""
+
+import numpy as np
+import pytest
+
+from gryffin_ros.planner import Planner
+from gryffin_ros.planner.strategies.stall import STALL_TOLERANCE, STALL_WINDOW, exploring_until, stall
+from gryffin_ros.planner.surrogates.gaussian_process import GaussianProcess
+
+
+def stalled_asks(merits, **kwargs):
+    """The numbers of experiments after which the ask is a stalled one."""
+    return [m for m in range(1, len(merits) + 1) if stall(np.asarray(merits[:m], dtype=float), **kwargs) is not None]
+
+
+def test_a_campaign_stalls_after_a_window_without_improvement_once_per_window():
+    flat = [1.0, 0.5] + [0.2] * 30
+    # from 2 windows on; then again a window later while nothing improves
+    assert stalled_asks(flat) == [2 * STALL_WINDOW, 3 * STALL_WINDOW, 4 * STALL_WINDOW]
+    assert stall(np.array(flat[:2 * STALL_WINDOW])) == 0.0
+    improving = np.linspace(1.0, 0.0, 40)  # every experiment better than the last
+    assert stalled_asks(improving) == []
+    # an improvement of 2 % of the range inside the window is not a stall; 0.5 % is
+    for step, stalls in ((2 * STALL_TOLERANCE, False), (STALL_TOLERANCE / 2, True)):
+        merits = [1.0, 0.0] + [0.5] * 12 + [-step] + [0.5] * 1
+        assert (stall(np.array(merits)) is not None) is stalls
+    # an improvement (experiment 17) ends a stall: the next is a whole window after it
+    assert stalled_asks([1.0] + [0.5] * 15 + [0.0] + [0.4] * 15) == [16, 25]
+
+
+def test_experiments_that_explored_options_on_purpose_start_no_stall():
+    flat = [0.0] + [0.5] * 30
+    assert stalled_asks(flat, since=20) == [28]  # a whole window after the exploring ones
+    # ligand and solvent of each experiment: the 2nd run of solvent 2 is experiment 6, the 2nd of ligand 3 the 5th
+    options = np.array([[0, 0], [1, 1], [0, 2], [3, 1], [3, 0], [1, 2], [0, 0], [1, 1]])
+    assert exploring_until(options, tries=2) == 6
+    assert exploring_until(options, tries=1) == 4  # ligand 3 first ran in experiment 4
+    assert exploring_until(np.empty((8, 0)), tries=2) == 0  # no such parameter
+
+
+def test_failed_experiments_improve_nothing_and_without_an_earlier_success_nothing_has_stalled():
+    nan = float("nan")
+    assert stalled_asks([0.0] + [nan] * 15) == [16]
+    assert stalled_asks([nan] * 10 + [0.3] * 6) == []  # nothing succeeded before the last window
+    assert stalled_asks([nan] * 20) == []
+
+
+def test_a_stalled_ask_predicts_what_the_campaign_has_not_tried_at_the_results_mean():
+    """Most results on a plateau (nothing reacted: 1.0), a few good ones at one corner: the fitted constant mean sits
+    near the plateau, so far from every experiment the GP predicts the plateau. At the results' mean it predicts the
+    mean of the results there instead; near the experiments the data decide as before."""
+    rng = np.random.default_rng(0)
+    config = {"parameters": [{"name": f"x{i}", "type": "continuous", "low": 0.0, "high": 1.0} for i in range(3)],
+              "objectives": [{"name": "y", "goal": "min"}]}
+    space = Planner(config, seed=0).space
+    plateau, good = rng.uniform(0.0, 0.3, (16, 3)), 0.05 + 0.1 * rng.random((8, 3))
+    y = np.concatenate([1.0 + 0.01 * rng.random(16), 0.1 + 0.2 * rng.random(8)])
+    gp = GaussianProcess(space, np.concatenate([plateau, good]), y, seed=0)
+
+    def predicted(points):  # standardized units (BoTorch's Standardize): 0 is the results' mean
+        mean, _ = gp.posterior.mean_and_sigma(gp.features.of(points))
+        return mean.detach().numpy()
+
+    plateau_level = (1.0 - y.mean()) / y.std(ddof=1)  # 0.67
+    far, near = np.array([[0.95, 0.95, 0.95]]), predicted(good)
+    assert 0.3 * plateau_level < predicted(far)[0] < plateau_level  # the fitted constant: toward the plateau
+    gp.at_results_mean()
+    # within a tenth of a standard deviation: what the data 0.9 or more away still say there
+    assert predicted(far)[0] == pytest.approx(0.0, abs=0.1)
+    assert predicted(good) == pytest.approx(near, abs=0.1)  # beside the experiments the data decide as before
+
+
+def test_a_planner_says_which_asks_followed_a_stall():
+    config = {"parameters": [{"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0},
+                             {"name": "x1", "type": "continuous", "low": 0.0, "high": 1.0},
+                             {"name": "x2", "type": "continuous", "low": 0.0, "high": 1.0}],
+              "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
+    planner = Planner(config, seed=1)
+    rng = np.random.default_rng(1)
+    # the best result first, then 14 poorer ones: the ask after the 16th is a stalled one, the next is not
+    results = [0.0] + list(1.0 + rng.random(2 * STALL_WINDOW))
+    points = rng.random((len(results), 3))
+    said = []
+    for i, (point, value) in enumerate(zip(points, results)):
+        planner.tell({"x0": point[0], "x1": point[1], "x2": point[2], "y": float(value)})
+        if i + 1 >= 2 * STALL_WINDOW - 1:
+            (proposal,), _, _ = planner.draw(1)
+            said.append((i + 1, "stalled" in proposal.meta))
+    assert said == [(15, False), (16, True), (17, False)]
+
+
+def test_a_planner_counts_no_stall_while_options_were_being_explored():
+    """The same 16 results, but the third solvent ran for the first and second time in experiments 14 and 15: those
+    explored it, so the ask after the 16th is no stalled one (it would be without the solvent)."""
+    config = {"parameters": [{"name": "solvent", "type": "categorical", "options": ["A", "B", "C"]},
+                             {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0},
+                             {"name": "x1", "type": "continuous", "low": 0.0, "high": 1.0}],
+              "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
+    rng = np.random.default_rng(2)
+    solvents = ["A", "B"] * 6 + ["A", "C", "C", "B"]
+    results = [0.0] + list(1.0 + rng.random(15))
+    planner = Planner(config, seed=2)
+    for solvent, point, value in zip(solvents, rng.random((16, 2)), results):
+        planner.tell({"solvent": solvent, "x0": point[0], "x1": point[1], "y": float(value)})
+    (proposal,), _, _ = planner.draw(1)
+    assert proposal.meta["surrogate"] == "gp" and "stalled" not in proposal.meta
