@@ -77,7 +77,7 @@ def test_a_planner_says_which_asks_followed_a_stall():
               "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
     planner = Planner(config, seed=1)
     rng = np.random.default_rng(1)
-    # the best result first, then 14 poorer ones: the ask after the 16th is a stalled one, the next is not
+    # the best result first, then 16 poorer ones: the ask after the 16th experiment is a stalled one, the next not
     results = [0.0] + list(1.0 + rng.random(2 * STALL_WINDOW))
     points = rng.random((len(results), 3))
     said = []
@@ -90,7 +90,7 @@ def test_a_planner_says_which_asks_followed_a_stall():
 
 
 def test_a_planner_counts_no_stall_while_options_were_being_explored():
-    """The same 16 results, but the third solvent ran for the first and second time in experiments 14 and 15: those
+    """16 results as above, but the third solvent ran for the first and second time in experiments 14 and 15: those
     explored it, so the ask after the 16th is no stalled one (it would be without the solvent)."""
     config = {"parameters": [{"name": "solvent", "type": "categorical", "options": ["A", "B", "C"]},
                              {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0},

@@ -31,8 +31,8 @@ def stall(merits: np.ndarray, since: int = 0, window: int = STALL_WINDOW, tolera
     last `window` experiments improved the best merit, as a share of the range of the results so far, if the ask after
     them is a stalled ask, else None. The ask after m experiments is one when m >= max(2 window, since + window), the
     best of the m improved on the best of the first m - window by less than `tolerance` of the range of the m's
-    results, and none of the previous window - 1 asks was one. `since`: the experiments up to it explored on purpose
-    (`exploring_until`) and end no stall."""
+    results, and none of the previous window - 1 asks was one. `since`: the first `since` experiments explored on
+    purpose (`exploring_until`); no window reaches into them."""
     merits = np.asarray(merits, dtype=float)
     failed = np.isnan(merits)
     best = np.fmin.accumulate(np.where(failed, np.inf, merits))
