@@ -34,7 +34,8 @@ from benchmarks.failing_region import failure_draws  # noqa: E402
 # the tasks' references (`task.reference()`: the closed-form optimum, or a dense grid refined by a coordinate search;
 # portfolio.py's table, results/portfolio.json)
 REFERENCES = {"m_coupling": -0.7402339145154431, "m_solvent": -0.9392404906079993, "s6_hartmann": -3.32236801,
-              "k_consecutive": -0.7610424477686307, "k_parallel": -0.8409831671906312}
+              "k_consecutive": -0.7610424477686307, "k_parallel": -0.8409831671906312,
+              "m_amination": -0.7898500948054701}
 
 
 def hidden_failure(task, x: list) -> bool:
