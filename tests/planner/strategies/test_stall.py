@@ -1,10 +1,18 @@
-"""Stalled campaigns: the rule that says when, and the GP ask that follows (untried regions at the results' mean)."""
+"""Stalled and settled campaigns: the rules that say when, and the GP asks that follow (untried regions at the results'
+mean; another combination of options)."""
 
 import numpy as np
 import pytest
 
 from gryffin_ros.planner import Planner
-from gryffin_ros.planner.strategies.stall import STALL_TOLERANCE, STALL_WINDOW, exploring_until, stall
+from gryffin_ros.planner.strategies.stall import (
+    SETTLE_LEAST,
+    STALL_TOLERANCE,
+    STALL_WINDOW,
+    exploring_until,
+    settled,
+    stall,
+)
 from gryffin_ros.planner.surrogates.gaussian_process import GaussianProcess
 
 
@@ -104,3 +112,51 @@ def test_a_planner_counts_no_stall_while_options_were_being_explored():
         planner.tell({"solvent": solvent, "x0": point[0], "x1": point[1], "y": float(value)})
     (proposal,), _, _ = planner.draw(1)
     assert proposal.meta["surrogate"] == "gp" and "stalled" not in proposal.meta
+
+
+def settled_asks(options):
+    """The numbers of experiments after which the ask is a settled one."""
+    return [m for m in range(1, len(options) + 1) if settled(np.asarray(options[:m])) is not None]
+
+
+def test_a_campaign_settles_when_most_of_a_window_ran_one_combination_once_per_window():
+    one = [[0, 1]] * 40
+    assert settled_asks(one) == [2 * STALL_WINDOW, 3 * STALL_WINDOW, 4 * STALL_WINDOW, 5 * STALL_WINDOW]
+    assert settled(np.array(one[:2 * STALL_WINDOW])).tolist() == [0, 1]
+    # SETTLE_LEAST of the window's experiments in one combination settle it, one fewer does not
+    varied = [[k % 3, k % 2] for k in range(2 * STALL_WINDOW)]  # no combination twice in a row
+    for alike, settles in ((SETTLE_LEAST, True), (SETTLE_LEAST - 1, False)):
+        options = varied[:-STALL_WINDOW] + [[4, 0]] * alike + varied[-(STALL_WINDOW - alike):]
+        assert (settled(np.array(options)) is not None) is settles
+        if settles:
+            assert settled(np.array(options)).tolist() == [4, 0]
+    assert settled_asks(varied) == []
+    # a window of one combination after 15 varied experiments: the ask after the 16th is the first settled one
+    assert settled_asks(varied[:8] + [[1, 1]] * 24) == [16, 24, 32]
+    assert settled(np.empty((2 * STALL_WINDOW, 0))) is not None  # no categorical parameter: the caller's concern
+
+
+def test_a_settled_campaign_runs_another_combination_and_says_so():
+    """Each option run twice, then every experiment on catalyst A with ligand p, the results improving there: the GP's
+    expected improvement stays on A / p; the ask after the 16th experiment runs the best result's conditions with one
+    option changed."""
+    config = {"parameters": [{"name": "catalyst", "type": "categorical", "options": ["A", "B", "C"]},
+                             {"name": "ligand", "type": "categorical", "options": ["p", "q"]},
+                             {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0}],
+              "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
+    rng = np.random.default_rng(3)
+    first = [("A", "q"), ("B", "p"), ("C", "q"), ("B", "q"), ("C", "p"), ("A", "q"), ("B", "p"), ("C", "q")]
+    runs = [(c, ligand, float(x), 1.0 + rng.random()) for (c, ligand), x in zip(first, rng.random(8))]
+    runs += [("A", "p", 0.1 * k, 0.5 - 0.05 * k) for k in range(1, 9)]  # a crawl along x0 on A / p
+    said = []
+    for m in (15, 16):
+        planner = Planner(config, seed=3)
+        for catalyst, ligand, x, y in runs[:m]:
+            planner.tell({"catalyst": catalyst, "ligand": ligand, "x0": x, "y": y})
+        (proposal,), _, _ = planner.draw(1)
+        said.append((m, "settled" in proposal.meta, (proposal.params["catalyst"], proposal.params["ligand"])))
+    assert said[0][:2] == (15, False)
+    assert said[1][:2] == (16, True) and said[1][2] != ("A", "p")
+    # the best result's conditions (x0 = 0.8, its last experiment), one option changed
+    assert sum(a != b for a, b in zip(said[1][2], ("A", "p"))) == 1
+    assert proposal.params["x0"] == pytest.approx(0.8)
