@@ -343,7 +343,8 @@ class Planner(BasePlanner):
         best of those candidates under the updated belief. While some option of a small categorical parameter has
         been run fewer than COVER_TRIES times, a point is the best candidate that holds one (`under_tried`); else,
         when the campaign has settled on one combination of those parameters' options (`settled`), the first point is
-        the best candidate that holds another. The second value: the proposals' meta entries that say so."""
+        the best result's conditions with one option changed (`_swaps`). The second value: the proposals' meta entries
+        that say so."""
         # failed experiments enter as believed results too: the GP learns nothing of the objective from them, so
         # without this their neighbourhood keeps its expected improvement and only P(feasible) holds the planner back
         failed = observed[np.array([o.failed for o in self.observations], dtype=bool)] if feasibility is not None \
@@ -409,9 +410,10 @@ class Planner(BasePlanner):
                ) -> tuple[np.ndarray, np.ndarray]:
         """The incumbent with one of its options of `dims` changed (to each other option of each), those that the
         known constraints allow and that do not hold the settled `combination`, scored: the conditions that work best
-        so far, tried with a neighbouring combination. Not optimized further: optimized elsewhere, the expected
-        improvement went to untried conditions (harness m_coupling, 12 seeds: seed 3 ran another base at 1.8 h instead
-        of 9.7 h, -0.07, and ended 0.093 short instead of 0.040; benchmarks/README.md round twenty-three)."""
+        so far, tried with a neighbouring combination. Not optimized further: optimized in another combination, the
+        expected improvement went to conditions nobody had tried (harness m_coupling seed 3 ran another base at 0.5 h
+        instead of the best result's 9.7 h, where nothing reacted, and ended 0.093 short instead of 0.040;
+        benchmarks/README.md round twenty-three)."""
         swaps = []
         for d in dims:
             for option in range(int(self.space.n_options[d])):
