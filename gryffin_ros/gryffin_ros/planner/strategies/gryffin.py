@@ -355,12 +355,13 @@ class Planner(BasePlanner):
         optimizer = self.optimizer()
         acquisition = GPAcquisition(gp)
         candidates, alpha = self._candidates(acquisition, start, exhaustive, optimizer, rng, feasibility)
-        under = self.under_tried(np.concatenate([observed, chosen]))
+        asked = np.concatenate([observed, chosen])
+        under = self.under_tried(asked)
         dims = self.space.small_categorical_dims(COVER_MAX_OPTIONS)
-        combination = settled(np.concatenate([observed, chosen])[:, dims]) if dims else None
+        combination = settled(asked[:, dims]) if dims else None
         swaps = None
         if combination is not None and not under:  # a settled campaign: the first point runs another combination
-            swaps = self._swaps(acquisition, dims, combination, incumbent, rng, feasibility)
+            swaps = self._swaps(acquisition, dims, combination, incumbent, optimizer, rng, feasibility)
         if under and not exhaustive:
             pinned, pinned_alpha = self._covering_candidates(acquisition, under, candidates, alpha, optimizer, rng,
                                                              feasibility)
@@ -406,8 +407,8 @@ class Planner(BasePlanner):
         return np.array(points), notes
 
     def _swaps(self, acquisition: AcquisitionFunction, dims: list[int], combination: np.ndarray,
-               incumbent: np.ndarray, rng: np.random.Generator, feasibility: FeasibilityModel | None
-               ) -> tuple[np.ndarray, np.ndarray]:
+               incumbent: np.ndarray, optimizer: AcquisitionOptimizer, rng: np.random.Generator,
+               feasibility: FeasibilityModel | None) -> tuple[np.ndarray, np.ndarray]:
         """The incumbent with one of its options of `dims` changed (to each other option of each), those that the
         known constraints allow and that do not hold the settled `combination`, scored: the conditions that work best
         so far, tried with a neighbouring combination. Not optimized further: optimized in another combination, the
@@ -425,7 +426,7 @@ class Planner(BasePlanner):
         swaps = swaps[elsewhere & self.constraints.feasible(swaps)]
         if not len(swaps):
             return swaps, np.empty(0)
-        return self._candidates(acquisition, swaps, True, self.optimizer(), rng, feasibility)
+        return self._candidates(acquisition, swaps, True, optimizer, rng, feasibility)  # scored, not optimized
 
     def under_tried(self, points: np.ndarray) -> list[tuple[int, int]]:
         """(dim, option) of the options of categorical parameters with 2 to COVER_MAX_OPTIONS options that fewer than
