@@ -131,7 +131,7 @@ def test_a_campaign_settles_when_most_of_a_window_ran_one_combination_once_per_w
         if settles:
             assert settled(np.array(options)).tolist() == [4, 0]
     assert settled_asks(varied) == []
-    # a window of one combination after 15 varied experiments: the ask after the 16th is the first settled one
+    # one combination after 8 varied experiments: settled from the ask after the 16th on (no earlier: m >= 2 windows)
     assert settled_asks(varied[:8] + [[1, 1]] * 24) == [16, 24, 32]
     assert settled(np.empty((2 * STALL_WINDOW, 0))) is not None  # no categorical parameter: the caller's concern
 

@@ -259,11 +259,11 @@ class Planner(BasePlanner):
         gp, meta = self.surrogate_choice.choose(X, merits, successful, density, descriptors)
         meta.update(feasibility.notes if feasibility is not None else {})
         report("optimizing", 0.0)
-        start, exhaustive = self.start_points(rng, X[int(np.argmin(merits))], X)
+        incumbent = X[int(np.argmin(merits))]
+        start, exhaustive = self.start_points(rng, incumbent, X)
         if gp is not None:
             self._after_stall(gp, meta)
-            points, notes = self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen,
-                                             X[int(np.argmin(merits))])
+            points, notes = self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen, incumbent)
             meta.update(notes)
             return points, [None] * n, meta
         return (*self._propose_kde(n, rng, density, start, exhaustive, feasibility, observed, chosen), meta)
