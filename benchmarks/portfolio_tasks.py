@@ -354,10 +354,11 @@ class Amination(Task):
 # held out as well (round twenty-four), written before the default was run on it: a categorical without descriptors
 # beside two with, a broad top (ten combinations within 0.22 of the best) instead of one sharp optimum
 
-PHOTOCATALYSTS = {"Ir-dF(CF3)ppy": (1.21, 3.36), "Ru(bpy)3": (0.77, 3.04), "4CzIPN": (1.35, 3.71), "EosinY": (0.83, 0.48),
-                  "Mes-Acr": (2.06, 0.78)}  # excited-state reduction potential (V vs SCE), log10 lifetime (ns)
+PHOTOCATALYSTS = {"Ir-dF(CF3)ppy": (1.21, 3.36), "Ru(bpy)3": (0.77, 3.04), "4CzIPN": (1.35, 3.71),
+                  "EosinY": (0.83, 0.48), "Mes-Acr": (2.06, 0.78)}  # E*(red) (V vs SCE), log10 lifetime (ns)
+# boiling point (deg C), polarity (E_T(30), normalized), dielectric constant
 PHOTO_SOLVENTS = {"MeCN": (82.0, 0.46, 37.5), "DMSO": (189.0, 0.44, 46.7), "DMF": (153.0, 0.39, 36.7),
-                  "DCM": (40.0, 0.31, 8.9)}  # boiling point (deg C), polarity (E_T(30), normalized), dielectric constant
+                  "DCM": (40.0, 0.31, 8.9)}
 PHOTO_ADDITIVES = ["none", "K2HPO4", "TFA"]
 PHOTO_OXIDATION = {"none": 1.25, "K2HPO4": 0.95, "TFA": 1.45}  # the substrate's oxidation potential (V) per additive
 PHOTO_BLEACHING = {"Ir-dF(CF3)ppy": 0.01, "Ru(bpy)3": 0.03, "4CzIPN": 0.05, "EosinY": 0.15, "Mes-Acr": 0.08}  # 1/h
