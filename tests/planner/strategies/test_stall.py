@@ -160,3 +160,26 @@ def test_a_settled_campaign_runs_another_combination_and_says_so():
     # the best result's conditions (x0 = 0.8, its last experiment), one option changed
     assert sum(a != b for a, b in zip(said[1][2], ("A", "p"))) == 1
     assert proposal.params["x0"] == pytest.approx(0.8)
+
+
+def test_a_settled_campaign_swaps_to_a_combination_it_has_not_run_first():
+    """A crawl on A / p (x0 up to 0.8); B / p ran at small x0 as well as A / p did there, A / q at 0.8 worse, C only
+    with q, poorly. The expected improvement of the swaps favours B / p at x0 = 0.8 (the trend along x0 carried
+    over); B / p has been run, C / p has not: the settled ask runs C / p at the best result's conditions."""
+    config = {"parameters": [{"name": "catalyst", "type": "categorical", "options": ["A", "B", "C"]},
+                             {"name": "ligand", "type": "categorical", "options": ["p", "q"]},
+                             {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0}],
+              "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
+    first = [("A", "q", 0.8, 0.3), ("B", "p", 0.1, 0.45), ("C", "q", 0.2, 3.0), ("B", "p", 0.2, 0.4),
+             ("C", "q", 0.8, 3.0), ("A", "q", 0.4, 0.6), ("B", "q", 0.3, 1.5), ("B", "q", 0.9, 1.4)]
+    for seed in (0, 1):
+        rng = np.random.default_rng(seed)
+        runs = [(c, ligand, x, y + 0.05 * rng.random()) for c, ligand, x, y in first]
+        runs += [("A", "p", 0.1 * k, 0.5 - 0.05 * k) for k in range(1, 9)]  # the crawl
+        planner = Planner(config, seed=seed)
+        for catalyst, ligand, x, y in runs:
+            planner.tell({"catalyst": catalyst, "ligand": ligand, "x0": x, "y": y})
+        (proposal,), _, _ = planner.draw(1)
+        assert "settled" in proposal.meta
+        assert (proposal.params["catalyst"], proposal.params["ligand"]) == ("C", "p")
+        assert proposal.params["x0"] == pytest.approx(0.8)
