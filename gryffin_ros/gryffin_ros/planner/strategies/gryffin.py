@@ -426,10 +426,11 @@ class Planner(BasePlanner):
                     swaps.append(incumbent.copy())
                     swaps[-1][d] = option
         swaps = np.array(swaps)
-        elsewhere = ~np.all(np.rint(swaps[:, dims]).astype(int) == combination, axis=1)
-        swaps = swaps[elsewhere & self.constraints.feasible(swaps)]
+        options = np.rint(swaps[:, dims]).astype(int)
+        keep = ~np.all(options == combination, axis=1) & self.constraints.feasible(swaps)
+        swaps, options = swaps[keep], options[keep]
         run = {tuple(c) for c in np.rint(asked[:, dims]).astype(int).tolist()}
-        untried = np.array([tuple(c) not in run for c in np.rint(swaps[:, dims]).astype(int).tolist()], dtype=bool)
+        untried = np.array([tuple(c) not in run for c in options.tolist()], dtype=bool)
         if untried.any():
             swaps = swaps[untried]
         if not len(swaps):
