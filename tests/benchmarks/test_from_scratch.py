@@ -14,6 +14,30 @@ def test_the_hidden_rules_fail_cs2co3_and_hot_dmf_only():
     assert not from_scratch.hidden_failure(task, [0, base("K3PO4"), solvent("EtOH"), 70.0, 2.0, 1.0])
 
 
+def test_the_hidden_rules_of_the_oxidation_fail_azado_and_hot_o2_only():
+    task = portfolio_tasks.TASKS["m_oxidation"]()
+    copper, nitroxyl = task.coppers.index, task.nitroxyls.index
+    air, o2 = portfolio_tasks.OX_ATMOSPHERES.index("air"), portfolio_tasks.OX_ATMOSPHERES.index("O2")
+    assert from_scratch.hidden_failure(task, [copper("CuBr"), nitroxyl("AZADO"), 2, air, 30.0, 8.0, 5.0])
+    assert from_scratch.hidden_failure(task, [copper("CuOTf"), nitroxyl("ABNO"), 1, o2, 42.0, 8.0, 5.0])
+    assert not from_scratch.hidden_failure(task, [copper("CuOTf"), nitroxyl("ABNO"), 1, o2, 38.0, 8.0, 5.0])
+    assert not from_scratch.hidden_failure(task, [copper("CuOTf"), nitroxyl("ABNO"), 1, air, 60.0, 8.0, 5.0])
+
+
+def test_the_oxidation_s_known_constraints_and_its_best_combination():
+    task = portfolio_tasks.TASKS["m_oxidation"]()
+    copper, nitroxyl = task.coppers.index, task.nitroxyls.index
+    air, o2 = portfolio_tasks.OX_ATMOSPHERES.index("air"), portfolio_tasks.OX_ATMOSPHERES.index("O2")
+    best = [copper("CuOTf"), nitroxyl("ABNO"), 1, air, 42.5, 7.5, 9.1]  # the dense grid's best point
+    assert task.feasible(best) and not from_scratch.hidden_failure(task, best)
+    assert not task.feasible([copper("CuI"), nitroxyl("ABNO"), 1, air, 42.5, 7.5, 4.0])  # CuI dissolves to 3 mol %
+    assert not task.feasible([copper("CuOTf"), nitroxyl("ABNO"), 1, o2, 46.0, 7.5, 5.0])  # O2 above 45 deg C
+    assert not task.feasible([copper("CuOTf"), nitroxyl("ABNO"), 0, air, 42.5, 7.5, 5.0])  # CuOTf without bpy
+    # the stored reference (the grid refined by a coordinate search) is at least as good as the grid's best point
+    # and within 0.001 of it (0.8165 against 0.8163); a changed objective or a wrong constant moves it out
+    assert 0.0 <= task.objective(best) - from_scratch.REFERENCES["m_oxidation"] < 1e-3
+
+
 def test_a_short_campaign_counts_its_failures_and_keeps_the_best_success():
     name, seed, failed, late, best = from_scratch.run(("m_coupling", 0, True, 6, 0.0))
     assert (name, seed) == ("m_coupling", 0) and 0 <= late <= failed <= 6
