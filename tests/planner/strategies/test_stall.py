@@ -162,24 +162,33 @@ def test_a_settled_campaign_runs_another_combination_and_says_so():
     assert proposal.params["x0"] == pytest.approx(0.8)
 
 
+CATALYST_LIGAND = {"parameters": [{"name": "catalyst", "type": "categorical", "options": ["A", "B", "C"]},
+                                  {"name": "ligand", "type": "categorical", "options": ["p", "q"]},
+                                  {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0}],
+                   "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
+
+
+def settled_ask_after_a_crawl(first, seed):
+    """The proposal of the ask after `first` (catalyst, ligand, x0, y; y with a little noise of `seed`) and a crawl
+    on A / p along x0 up to 0.8, improving on every experiment."""
+    rng = np.random.default_rng(seed)
+    runs = [(c, ligand, x, y + 0.05 * rng.random()) for c, ligand, x, y in first]
+    runs += [("A", "p", 0.1 * k, 0.5 - 0.05 * k) for k in range(1, 9)]  # the crawl
+    planner = Planner(CATALYST_LIGAND, seed=seed)
+    for catalyst, ligand, x, y in runs:
+        planner.tell({"catalyst": catalyst, "ligand": ligand, "x0": x, "y": y})
+    (proposal,), _, _ = planner.draw(1)
+    return proposal
+
+
 def test_a_settled_campaign_swaps_to_a_combination_it_has_not_run_first():
     """A crawl on A / p (x0 up to 0.8); B / p ran at small x0 as well as A / p did there, A / q at 0.8 worse, C only
     with q, poorly. The expected improvement of the swaps favours B / p at x0 = 0.8 (the trend along x0 carried
     over); B / p has been run, C / p has not: the settled ask runs C / p at the best result's conditions."""
-    config = {"parameters": [{"name": "catalyst", "type": "categorical", "options": ["A", "B", "C"]},
-                             {"name": "ligand", "type": "categorical", "options": ["p", "q"]},
-                             {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0}],
-              "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
     first = [("A", "q", 0.8, 0.3), ("B", "p", 0.1, 0.45), ("C", "q", 0.2, 3.0), ("B", "p", 0.2, 0.4),
              ("C", "q", 0.8, 3.0), ("A", "q", 0.4, 0.6), ("B", "q", 0.3, 1.5), ("B", "q", 0.9, 1.4)]
     for seed in (0, 1):
-        rng = np.random.default_rng(seed)
-        runs = [(c, ligand, x, y + 0.05 * rng.random()) for c, ligand, x, y in first]
-        runs += [("A", "p", 0.1 * k, 0.5 - 0.05 * k) for k in range(1, 9)]  # the crawl
-        planner = Planner(config, seed=seed)
-        for catalyst, ligand, x, y in runs:
-            planner.tell({"catalyst": catalyst, "ligand": ligand, "x0": x, "y": y})
-        (proposal,), _, _ = planner.draw(1)
+        proposal = settled_ask_after_a_crawl(first, seed)
         assert "settled" in proposal.meta
         assert (proposal.params["catalyst"], proposal.params["ligand"]) == ("C", "p")
         assert proposal.params["x0"] == pytest.approx(0.8)
@@ -188,20 +197,10 @@ def test_a_settled_campaign_swaps_to_a_combination_it_has_not_run_first():
 def test_a_settled_campaign_whose_neighbours_have_all_run_changes_two_options():
     """Every combination one option away from A / p (B / p, C / p, A / q) has run, B / q and C / q have not: the
     settled ask runs one of those two at the best result's conditions."""
-    config = {"parameters": [{"name": "catalyst", "type": "categorical", "options": ["A", "B", "C"]},
-                             {"name": "ligand", "type": "categorical", "options": ["p", "q"]},
-                             {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0}],
-              "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
     first = [("B", "p", 0.3, 0.8), ("C", "p", 0.6, 1.2), ("A", "q", 0.5, 0.9), ("B", "p", 0.8, 0.7),
              ("C", "p", 0.2, 1.3), ("A", "q", 0.9, 0.8), ("B", "p", 0.5, 0.75), ("A", "q", 0.1, 1.0)]
     for seed in (0, 1):
-        rng = np.random.default_rng(seed)
-        runs = [(c, ligand, x, y + 0.05 * rng.random()) for c, ligand, x, y in first]
-        runs += [("A", "p", 0.1 * k, 0.5 - 0.05 * k) for k in range(1, 9)]  # the crawl
-        planner = Planner(config, seed=seed)
-        for catalyst, ligand, x, y in runs:
-            planner.tell({"catalyst": catalyst, "ligand": ligand, "x0": x, "y": y})
-        (proposal,), _, _ = planner.draw(1)
+        proposal = settled_ask_after_a_crawl(first, seed)
         assert "settled" in proposal.meta
         assert (proposal.params["catalyst"], proposal.params["ligand"]) in {("B", "q"), ("C", "q")}
         assert proposal.params["x0"] == pytest.approx(0.8)
