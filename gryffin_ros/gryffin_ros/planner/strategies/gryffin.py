@@ -425,28 +425,28 @@ class Planner(BasePlanner):
         combinations changed catalyst and additive; held out, m_oxidation from scratch with hidden failures, seed 2:
         0.318 -> 0.015 short; round twenty-five); when those have all run too, every swap of one option."""
         run = {tuple(c) for c in np.rint(asked[:, dims]).astype(int).tolist()}
+        neighbours = self._changed(incumbent, dims, 1)
         for k in (1, 2):
-            swaps = self._changed(incumbent, dims, k)
-            swaps = swaps[self.constraints.feasible(swaps)] if len(swaps) else swaps
+            swaps = neighbours if k == 1 else self._changed(incumbent, dims, 2)
             untried = np.array([tuple(c) not in run for c in np.rint(swaps[:, dims]).astype(int).tolist()], dtype=bool)
-            if untried.any():
-                return self._candidates(acquisition, swaps[untried], True, optimizer, rng, feasibility)  # not optimized
-        swaps = self._changed(incumbent, dims, 1)
-        elsewhere = ~np.all(np.rint(swaps[:, dims]).astype(int) == combination, axis=1)
-        swaps = swaps[elsewhere & self.constraints.feasible(swaps)]
+            if untried.any():  # scored, not optimized
+                return self._candidates(acquisition, swaps[untried], True, optimizer, rng, feasibility)
+        swaps = neighbours[~np.all(np.rint(neighbours[:, dims]).astype(int) == combination, axis=1)]
         if not len(swaps):
             return swaps, np.empty(0)
-        return self._candidates(acquisition, swaps, True, optimizer, rng, feasibility)
+        return self._candidates(acquisition, swaps, True, optimizer, rng, feasibility)  # scored, not optimized
 
     def _changed(self, point: np.ndarray, dims: list[int], k: int) -> np.ndarray:
-        """`point` with k of its options of `dims` changed, to every other option of each: (M, D), M >= 0."""
+        """`point` with k of its options of `dims` changed, to every other option of each, those that the known
+        constraints allow: (M, D), M >= 0."""
         out = []
         for chosen in itertools.combinations(dims, k):
             others = [[o for o in range(int(self.space.n_options[d])) if o != round(point[d])] for d in chosen]
             for options in itertools.product(*others):
                 out.append(point.copy())
                 out[-1][list(chosen)] = options
-        return np.array(out).reshape(-1, len(point))
+        out = np.array(out).reshape(-1, len(point))
+        return out[self.constraints.feasible(out)] if len(out) else out
 
     def under_tried(self, points: np.ndarray) -> list[tuple[int, int]]:
         """(dim, option) of the options of categorical parameters with 2 to COVER_MAX_OPTIONS options that fewer than
