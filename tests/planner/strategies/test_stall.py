@@ -136,21 +136,23 @@ def test_a_campaign_settles_when_most_of_a_window_ran_one_combination_once_per_w
     assert settled(np.empty((2 * STALL_WINDOW, 0))) is not None  # no categorical parameter: the caller's concern
 
 
+CATALYST_LIGAND = {"parameters": [{"name": "catalyst", "type": "categorical", "options": ["A", "B", "C"]},
+                                  {"name": "ligand", "type": "categorical", "options": ["p", "q"]},
+                                  {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0}],
+                   "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
+
+
 def test_a_settled_campaign_runs_another_combination_and_says_so():
     """Each option run twice, then every experiment on catalyst A with ligand p, the results improving there: the GP's
     expected improvement stays on A / p; the ask after the 16th experiment runs the best result's conditions with one
     option changed."""
-    config = {"parameters": [{"name": "catalyst", "type": "categorical", "options": ["A", "B", "C"]},
-                             {"name": "ligand", "type": "categorical", "options": ["p", "q"]},
-                             {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0}],
-              "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
     rng = np.random.default_rng(3)
     first = [("A", "q"), ("B", "p"), ("C", "q"), ("B", "q"), ("C", "p"), ("A", "q"), ("B", "p"), ("C", "q")]
     runs = [(c, ligand, float(x), 1.0 + rng.random()) for (c, ligand), x in zip(first, rng.random(8))]
     runs += [("A", "p", 0.1 * k, 0.5 - 0.05 * k) for k in range(1, 9)]  # a crawl along x0 on A / p
     said = []
     for m in (15, 16):
-        planner = Planner(config, seed=3)
+        planner = Planner(CATALYST_LIGAND, seed=3)
         for catalyst, ligand, x, y in runs[:m]:
             planner.tell({"catalyst": catalyst, "ligand": ligand, "x0": x, "y": y})
         (proposal,), _, _ = planner.draw(1)
@@ -160,12 +162,6 @@ def test_a_settled_campaign_runs_another_combination_and_says_so():
     # the best result's conditions (x0 = 0.8, its last experiment), one option changed
     assert sum(a != b for a, b in zip(said[1][2], ("A", "p"))) == 1
     assert proposal.params["x0"] == pytest.approx(0.8)
-
-
-CATALYST_LIGAND = {"parameters": [{"name": "catalyst", "type": "categorical", "options": ["A", "B", "C"]},
-                                  {"name": "ligand", "type": "categorical", "options": ["p", "q"]},
-                                  {"name": "x0", "type": "continuous", "low": 0.0, "high": 1.0}],
-                   "objectives": [{"name": "y", "goal": "min"}], "general": {"surrogate": "gp"}}
 
 
 def settled_ask_after_a_crawl(first, seed):
