@@ -471,6 +471,61 @@ class Oxidation(Task):
         return dense_reference(self, cont_steps=21)
 
 
+# held out (round twenty-six): written, and its constants set on its landscape only (each combination's best), before
+# the default ran on it. An ordered discrete parameter whose best level depends on the categorical one (the pH per
+# enzyme), a linear known constraint that couples two continuous conditions (the substrate-to-enzyme ratio), an
+# optimum on one bound of one condition and inside the others, a quarter of the combinations giving nothing
+
+# melting temperature (deg C), specific activity (normalized), pH optimum
+BIO_ENZYMES = {"KRED-A": (48.0, 1.0, 7.2), "KRED-B": (56.0, 0.55, 7.6), "KRED-C": (62.0, 0.30, 8.1),
+               "ADH-LK": (42.0, 1.6, 6.6), "ADH-TB": (72.0, 0.18, 7.4)}
+BIO_COSOLVENTS = {"none": (-1.38, 80.1), "IPA": (0.05, 18.3), "DMSO": (-1.35, 46.7),
+                  "MeOH": (-0.77, 32.7)}  # log P, dielectric constant (none: the buffer's water)
+BIO_SOLUBILITY = {"none": 40.0, "IPA": 150.0, "DMSO": 120.0, "MeOH": 90.0}  # g/L of the ketone in 10 % cosolvent
+BIO_DENATURING = {"none": 0.0, "IPA": 0.7, "DMSO": 0.25, "MeOH": 0.9}  # how far the cosolvent lowers stability
+BIO_RECYCLING = {"none": 1.0, "IPA": 1.5, "DMSO": 0.9, "MeOH": 0.85}  # cofactor recycling (IPA: substrate-coupled)
+BIO_MAX_RATIO = 60.0  # g of substrate per g of enzyme
+
+
+class Biocatalysis(Task):
+    """A ketoreductase reduction of a prochiral ketone (held out): enzyme and cosolvent (categorical, with
+    descriptors), buffer pH (6-9, ordered) + temperature, substrate loading, enzyme loading and time (continuous).
+    Known constraints: 8 deg C below each enzyme's melting temperature (the supplier's limit), the substrate's
+    solubility in each cosolvent caps its loading, at most 60 g of substrate per g of enzyme. Each enzyme works
+    near its own pH optimum and dies fast near its melting temperature, sooner in a denaturing cosolvent; IPA
+    recycles the cofactor; substrate inhibits; the value is the conversion weighted toward high loadings, less the
+    enzyme's and the time's cost. One best combination (0.68), a step to 0.64 and 0.63, a quarter of the 80
+    combinations giving nothing (the pH far from the enzyme's)."""
+    name, family, budget = "m_biocatalysis", "mixed_heldout", 40
+
+    def __init__(self):
+        self.enzymes, self.cosolvents = list(BIO_ENZYMES), list(BIO_COSOLVENTS)
+        self.params = [CatParam("enzyme", self.enzymes, BIO_ENZYMES),
+                       CatParam("cosolvent", self.cosolvents, BIO_COSOLVENTS), Param("pH", "int", 6, 9),
+                       Param("T", "float", 20.0, 60.0), Param("substrate", "float", 10.0, 150.0),
+                       Param("enzyme_loading", "float", 0.5, 5.0), Param("t", "float", 2.0, 24.0)]
+
+    def feasible(self, x):
+        enzyme, cosolvent, T, substrate, loading = self.enzymes[int(x[0])], self.cosolvents[int(x[1])], x[3], x[4], x[5]
+        return (T <= BIO_ENZYMES[enzyme][0] - 8.0 and substrate <= BIO_SOLUBILITY[cosolvent]
+                and substrate <= BIO_MAX_RATIO * loading)
+
+    def objective(self, x):
+        melting, activity, ph_optimum = BIO_ENZYMES[self.enzymes[int(x[0])]]
+        cosolvent = self.cosolvents[int(x[1])]
+        pH, T, substrate, loading, t = int(x[2]), x[3], x[4], x[5], x[6]
+        k_cat = (30.0 * activity * math.exp(-((pH - ph_optimum) / 0.6) ** 2) * BIO_RECYCLING[cosolvent]
+                 * math.exp(-5500 * (1 / (T + 273.15) - 1 / 303.15)))
+        k_dead = 0.01 * math.exp((T - melting + 14.0 + 12.0 * BIO_DENATURING[cosolvent]) / 3.5)
+        exposure = (1 - math.exp(-k_dead * t)) / k_dead  # hours weighted by the enzyme still active
+        rate = k_cat * loading / (1 + (substrate / 80.0) ** 2)  # substrate inhibition
+        conversion = 1 - math.exp(-rate * exposure / (15.0 + substrate))
+        return -(conversion * (0.3 + 0.7 * substrate / 150.0) - 0.04 * loading - 0.006 * t)
+
+    def reference(self):
+        return dense_reference(self, cont_steps=11)
+
+
 # ----------------------------------------------------------------------------------------------------------------
 # reaction kinetics in a flow reactor
 
@@ -572,4 +627,4 @@ def dense_reference(task, cont_steps: int, polish_from: int = 20) -> float:
 FAMILIES = ("smooth2", "smooth6", "smooth10", "mixed", "kinetics", "mixed_heldout")
 TASKS = {t.name: t for t in (Camel2, Rosenbrock2, Hartmann6, Ellipsoid6, Ellipsoid10, Styblinski10, Solvent,
                              Catalyst, Discrete, Coupling, Consecutive, Parallel, Amination, Photoredox,
-                             Oxidation)}
+                             Oxidation, Biocatalysis)}
