@@ -38,7 +38,6 @@ def test_the_oxidation_s_known_constraints_and_its_best_combination():
     assert 0.0 <= task.objective(best) - from_scratch.REFERENCES["m_oxidation"] < 1e-3
 
 
-
 def test_the_biocatalysis_s_known_constraints_and_its_best_combination():
     task = portfolio_tasks.TASKS["m_biocatalysis"]()
     enzyme, cosolvent = task.enzymes.index, task.cosolvents.index
@@ -50,6 +49,7 @@ def test_the_biocatalysis_s_known_constraints_and_its_best_combination():
     # the stored reference (the grid refined by a coordinate search) is at least as good as the grid's best point
     # and within 0.001 of it (0.6788 against 0.6779)
     assert 0.0 <= task.objective(best) - from_scratch.REFERENCES["m_biocatalysis"] < 1e-3
+
 
 def test_a_short_campaign_counts_its_failures_and_keeps_the_best_success():
     name, seed, failed, late, best = from_scratch.run(("m_coupling", 0, True, 6, 0.0))
