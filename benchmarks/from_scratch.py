@@ -39,7 +39,8 @@ from benchmarks.failing_region import failure_draws  # noqa: E402
 REFERENCES = {"m_coupling": -0.7402339145154431, "m_solvent": -0.9392404906079993, "s6_hartmann": -3.32236801,
               "k_consecutive": -0.7610424477686307, "k_parallel": -0.8409831671906312,
               "m_amination": -0.7898500948054701, "m_photoredox": -0.8558160481769198,
-              "m_oxidation": -0.8164543183802141, "m_biocatalysis": -0.6787806044424859}
+              "m_oxidation": -0.8164543183802141, "m_biocatalysis": -0.6787806044424859,
+              "m_hydrogenation": -0.8891914040803628}
 
 
 HIDDEN = ("m_coupling", "m_oxidation")  # the tasks with hidden failures (above)
