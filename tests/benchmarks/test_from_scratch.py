@@ -24,6 +24,15 @@ def test_the_hidden_rules_of_the_oxidation_fail_azado_and_hot_o2_only():
     assert not from_scratch.hidden_failure(task, [copper("CuOTf"), nitroxyl("ABNO"), 1, air, 60.0, 8.0, 5.0])
 
 
+
+def test_the_hidden_rules_of_the_hydrogenation_fail_josiphos_and_above_60_degrees_only():
+    task = portfolio_tasks.TASKS["m_hydrogenation"]()
+    metal, ligand, solvent = portfolio_tasks.HYD_METALS.index, task.ligands.index, task.solvents.index
+    assert from_scratch.hidden_failure(task, [metal("Rh"), ligand("Josiphos"), solvent("MeOH"), 9.0, 20.0, 0.4])
+    assert from_scratch.hidden_failure(task, [metal("Ru"), ligand("SegPhos"), solvent("toluene"), 1.0, 62.0, 0.4])
+    assert not from_scratch.hidden_failure(task, [metal("Ru"), ligand("SegPhos"), solvent("toluene"), 1.0, 58.0, 0.4])
+    assert not from_scratch.hidden_failure(task, [metal("Ru"), ligand("SegPhos"), solvent("MeOH"), 75.0, 13.3, 0.49])
+
 def test_the_oxidation_s_known_constraints_and_its_best_combination():
     task = portfolio_tasks.TASKS["m_oxidation"]()
     copper, nitroxyl = task.coppers.index, task.nitroxyls.index
