@@ -540,7 +540,8 @@ HYD_SOLVENTS = {"MeOH": (65.0, 3.9, 1.0), "TFE": (74.0, 2.8, 1.0), "DCM": (40.0,
 # cationic iridium dies in coordinating solvents; the rhodium precursor does not dissolve in toluene
 HYD_FORBIDDEN = {("Ir", "MeOH"), ("Ir", "THF"), ("Rh", "toluene")}
 # per metal: the ligand's bite angle and donor strength it wants, rate constant (1/h per mol %), H2 half-saturation
-# (mM), the ee of a perfect ligand at 10 deg C, the ee's change per bar above 10 bar
+# (mM), the ee of a perfect ligand at 10 deg C, the ee's relative change per bar from 10 bar (capped at no change:
+# rhodium loses ee above 10 bar, ruthenium below)
 HYD_METAL = {"Rh": (84.0, 0.85, 2.0, 8.0, 0.93, -0.012), "Ru": (89.0, 0.48, 2.5, 120.0, 0.99, 0.004),
              "Ir": (85.0, 0.25, 2.0, 60.0, 0.88, 0.0)}
 HYD_SOLVENT_FIT = {"Rh": {"MeOH": 1.0, "TFE": 0.8, "DCM": 0.6, "THF": 0.5, "toluene": 0.3},
@@ -554,9 +555,9 @@ class Hydrogenation(Task):
     descriptors), chiral bisphosphine or P,N ligand and solvent (categorical, with descriptors) + H2 pressure,
     temperature and catalyst loading (continuous), 16 h. Known constraints: 5 deg C below the solvent's boiling point,
     the vessel's rating (80 bar at 10 deg C, 1.5 bar less per degree), three metal / solvent pairs that do not work.
-    Each metal wants its own ligand shape; rhodium needs little H2 and loses ee under pressure, ruthenium needs much
-    and gains ee, iridium is in between and wants a non-coordinating solvent; rates rise and ee falls with the
-    temperature, the catalyst dies when hot; the value is conversion x ee less the catalyst's cost. One best
+    Each metal wants its own ligand shape; rhodium needs little H2 and loses ee above 10 bar, ruthenium needs much
+    and loses ee below 10 bar, iridium is in between and wants a non-coordinating solvent; rates rise and ee falls with
+    the temperature, the catalyst dies when hot; the value is conversion x ee less the catalyst's cost. One best
     combination (0.889, Ru / SegPhos / MeOH on the vessel's rating), its TFE twin at 0.876, a step to 0.81 and the
     rhodium family near 0.80 at 9 bar; 40 of the 72 allowed combinations give less than 0.05."""
     name, family, budget = "m_hydrogenation", "mixed_heldout", 40

@@ -24,7 +24,6 @@ def test_the_hidden_rules_of_the_oxidation_fail_azado_and_hot_o2_only():
     assert not from_scratch.hidden_failure(task, [copper("CuOTf"), nitroxyl("ABNO"), 1, air, 60.0, 8.0, 5.0])
 
 
-
 def test_the_hidden_rules_of_the_hydrogenation_fail_josiphos_and_above_60_degrees_only():
     task = portfolio_tasks.TASKS["m_hydrogenation"]()
     metal, ligand, solvent = portfolio_tasks.HYD_METALS.index, task.ligands.index, task.solvents.index
@@ -32,6 +31,7 @@ def test_the_hidden_rules_of_the_hydrogenation_fail_josiphos_and_above_60_degree
     assert from_scratch.hidden_failure(task, [metal("Ru"), ligand("SegPhos"), solvent("toluene"), 1.0, 62.0, 0.4])
     assert not from_scratch.hidden_failure(task, [metal("Ru"), ligand("SegPhos"), solvent("toluene"), 1.0, 58.0, 0.4])
     assert not from_scratch.hidden_failure(task, [metal("Ru"), ligand("SegPhos"), solvent("MeOH"), 75.0, 13.3, 0.49])
+
 
 def test_the_oxidation_s_known_constraints_and_its_best_combination():
     task = portfolio_tasks.TASKS["m_oxidation"]()
@@ -75,6 +75,7 @@ def test_the_hydrogenation_s_known_constraints_and_its_best_combination():
     # the stored reference (a grid of 21 levels refined by a coordinate search; 41 levels give the same) is at least
     # as good as the fine grid's best point and within 0.001 of it (0.88919 against 0.88917)
     assert 0.0 <= task.objective(best) - from_scratch.REFERENCES["m_hydrogenation"] < 1e-3
+
 
 def test_a_short_campaign_counts_its_failures_and_keeps_the_best_success():
     name, seed, failed, late, best = from_scratch.run(("m_coupling", 0, True, 6, 0.0))
