@@ -612,6 +612,7 @@ CR_SALT = {"HCl": (90.0, 2.0), "MsOH": (120.0, 3.2), "TsOH": (100.0, 6.0), "male
 CR_SOLVATES = {"HCl", "maleic"}
 CR_REJECTION = {"EtOH": 0.97, "IPA": 0.985, "acetone": 0.93, "EtOAc": 0.95, "MeCN": 0.96}  # purity, slow growth
 CR_MAX_HOURS = 7.0  # the cooling must end within a shift
+CR_START_BELOW_BP = 10.0  # deg C: the salt is dissolved this far below the solvent's boiling point
 
 
 class Crystallization(Task):
@@ -622,7 +623,8 @@ class Crystallization(Task):
     salt's measured hot solubility), the cooling ends within 7 h, two solvent / antisolvent pairs that do not mix.
     Protic solvents give steep solubility curves (cooling alone crystallizes), aprotic ones flat (an antisolvent is
     needed); above its critical supersaturation a salt comes out as the unwanted form (half the value); acids within
-    2.5 pKa units of the base form salts poorly; hydrophobic salts oil out with water. The value is the pure salt
+    2.5 pKa units of the base form salts poorly; hydrophobic salts oil out with water; the hydrochloride and the
+    maleate come out of alcohols as solvates. The value is the pure salt
     recovered per litre of solvent (scaled) less the hours and the antisolvent. One best combination (0.669, maleate
     from MeCN with MTBE, at the highest concentration and antisolvent fraction, on the unwanted form's edge), the
     alcohol family of tosylate and mesylate 0.59-0.63, maleate with water 0.54; 8 of the 69 allowed combinations give
@@ -644,9 +646,14 @@ class Crystallization(Task):
         s25 = CR_SALT[acid][0] * math.exp(-((polarity - (0.8 - 0.6 * hydrophobic)) / 0.25) ** 2)
         return s25 * math.exp((0.015 + 0.03 * protic) * (T - 25.0))
 
+    @staticmethod
+    def start(solvent):
+        """The temperature (deg C) the salt is dissolved at and cooled from."""
+        return CR_SOLVENTS[solvent][0] - CR_START_BELOW_BP
+
     def feasible(self, x):
         acid, solvent = self.acids[int(x[0])], self.solvents[int(x[1])]
-        start = CR_SOLVENTS[solvent][0] - 10.0
+        start = self.start(solvent)
         return (x[3] <= self.solubility(acid, solvent, start) and (start - x[4]) / x[5] <= 60.0 * CR_MAX_HOURS
                 and (solvent, CR_ANTISOLVENTS[int(x[2])]) not in CR_FORBIDDEN)
 
@@ -667,7 +674,7 @@ class Crystallization(Task):
             purity *= 0.6
         if anti == "water" and hydrophobic > 0.6 and f > 0.1:
             purity *= 0.4
-        hours = (CR_SOLVENTS[solvent][0] - 10.0 - T) / rate / 60.0 + 1.0
+        hours = (self.start(solvent) - T) / rate / 60.0 + 1.0
         return -(salt * purity * conc * (1 - 1 / sigma) / 250.0 - 0.01 * hours - 0.05 * f)
 
     def reference(self):

@@ -97,7 +97,7 @@ def test_the_crystallization_s_known_constraints_and_its_best_combination():
     # on that edge, and without the antisolvent the flat curve in MeCN crystallizes far less
     assert task.objective(best[:4] + [18.0] + best[5:]) > task.objective(best) + 0.25
     assert task.objective(best[:6] + [0.0]) > task.objective(best) + 0.25
-    # the antisolvent has no descriptors and the best needs MTBE: water dissolves the maleate (less power)
+    # the antisolvent has no descriptors and the best needs MTBE: water drives the maleate out far less
     assert task.objective([acid("maleic"), solvent("MeCN"), anti("water")] + best[3:]) > task.objective(best) + 0.1
     # the stored reference (a grid of 11 levels refined by a coordinate search; 16 levels give the same) is at least
     # as good as the fine grid's best point and within 0.001 of it
