@@ -48,22 +48,23 @@ REFERENCES = {"m_coupling": -0.7402339145154431, "m_solvent": -0.939240490607999
               "m_hydrogenation": -0.8891914040803628, "m_crystallization": -0.6689293085972873}
 
 
-# the tasks with hidden failures (above)
-HIDDEN = ("m_coupling", "m_oxidation", "m_hydrogenation", "m_crystallization")
+# the hidden rules by task (above): whether the experiment x (a harness point) of the task fails
+HIDDEN_RULES: dict[str, Callable] = {
+    "m_coupling": lambda task, x: (task.bases[int(x[1])] == "Cs2CO3"
+                                   or (task.solvents[int(x[2])] == "DMF" and x[3] > 110.0)),
+    "m_oxidation": lambda task, x: (task.nitroxyls[int(x[1])] == "AZADO"
+                                    or (portfolio_tasks.OX_ATMOSPHERES[int(x[3])] == "O2" and x[4] > 40.0)),
+    "m_hydrogenation": lambda task, x: task.ligands[int(x[1])] == "Josiphos" or x[4] > 60.0,
+    "m_crystallization": lambda task, x: task.solvents[int(x[1])] == "acetone" or x[5] > 1.2,
+}
+HIDDEN = tuple(HIDDEN_RULES)  # the tasks with hidden failures
 
 
 def hidden_failure(task, x: list) -> bool:
     """Whether the experiment x (a harness point) fails by the hidden rules of `task` (`--hidden`)."""
-    if task.name == "m_coupling":
-        return task.bases[int(x[1])] == "Cs2CO3" or (task.solvents[int(x[2])] == "DMF" and x[3] > 110.0)
-    if task.name == "m_oxidation":
-        return (task.nitroxyls[int(x[1])] == "AZADO"
-                or (portfolio_tasks.OX_ATMOSPHERES[int(x[3])] == "O2" and x[4] > 40.0))
-    if task.name == "m_hydrogenation":
-        return task.ligands[int(x[1])] == "Josiphos" or x[4] > 60.0
-    if task.name == "m_crystallization":
-        return task.solvents[int(x[1])] == "acetone" or x[5] > 1.2
-    raise ValueError(f"--hidden is defined for {', '.join(HIDDEN)} only, not {task.name}")
+    if task.name not in HIDDEN_RULES:
+        raise ValueError(f"--hidden is defined for {', '.join(HIDDEN)} only, not {task.name}")
+    return bool(HIDDEN_RULES[task.name](task, x))
 
 
 def campaign(task, seed: int, budget: int, fails: Callable[[int, list], bool]) -> tuple[int, int, float]:
