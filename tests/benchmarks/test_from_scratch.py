@@ -104,6 +104,45 @@ def test_the_crystallization_s_known_constraints_and_its_best_combination():
     assert 0.0 <= task.objective(best) - from_scratch.REFERENCES["m_crystallization"] < 1e-3
 
 
+def test_the_electrochemistry_s_known_constraints_and_its_best_combination():
+    task = portfolio_tasks.TASKS["m_electrochem"]()
+    anode, electrolyte, solvent = task.anodes.index, portfolio_tasks.EC_ELECTROLYTES.index, task.solvents.index
+    combination = [anode("BDD"), electrolyte("LiClO4"), solvent("HFIP")]
+    best = combination + [13.05, 2.92, 29.34, 0.5]  # SLSQP's best, rounded inward
+    assert task.feasible(best) and not from_scratch.hidden_failure(task, best)
+    # both limits bind there: a little more current exceeds the potentiostat's 12 V, a little more charge (or less
+    # current) the 6 h of a run; warmer (a better conductor, more current allowed) loses the radical cation
+    assert not task.feasible(combination + [13.3, 2.92, 29.34, 0.5])
+    assert not task.feasible(combination + [13.05, 3.0, 29.34, 0.5])
+    assert not task.feasible(combination + [12.8, 2.92, 29.34, 0.5])
+    assert task.feasible(combination + [14.0, 2.92, 34.0, 0.5])
+    assert task.objective(combination + [14.0, 2.92, 34.0, 0.5]) > task.objective(best)
+    # what the current density may be depends on the combination: HFIP conducts poorly, MeCN well
+    assert not task.feasible([anode("RVC"), electrolyte("Et4NOTs"), solvent("HFIP"), 10.0, 2.0, 30.0, 0.1])
+    assert task.feasible([anode("RVC"), electrolyte("Et4NOTs"), solvent("MeCN"), 30.0, 2.0, 30.0, 0.1])
+    assert not task.feasible([anode("BDD"), electrolyte("LiClO4"), solvent("MeOH"), 13.0, 2.9, 56.0, 0.5])  # boils
+    assert not task.feasible([anode("Ni"), electrolyte("LiClO4"), solvent("HFIP"), 5.0, 2.0, 30.0, 0.1])
+    assert not task.feasible([anode("RVC"), electrolyte("KOAc"), solvent("MeCN"), 5.0, 2.0, 30.0, 0.1])
+    # the electrolyte has no descriptors and the best needs the perchlorate: the tosylate conducts too little
+    assert not task.feasible([anode("BDD"), electrolyte("Et4NOTs"), solvent("HFIP")] + best[3:])
+    # the methanol family is good everywhere in a broad region, below the best
+    assert -task.objective([anode("RVC"), electrolyte("KOAc"), solvent("MeOH"), 15.0, 3.35, 21.6, 0.5]) > 0.44
+    # the stored reference (SLSQP from 40 random starts per combination; a scan along both limits agrees) is at least
+    # as good as the rounded best point and within 0.001 of it
+    assert 0.0 <= task.objective(best) - from_scratch.REFERENCES["m_electrochem"] < 1e-3
+
+
+def test_the_hidden_rules_of_the_electrochemistry_fail_dmf_and_high_current_only():
+    task = portfolio_tasks.TASKS["m_electrochem"]()
+    anode, electrolyte, solvent = task.anodes.index, portfolio_tasks.EC_ELECTROLYTES.index, task.solvents.index
+    assert from_scratch.hidden_failure(task, [anode("RVC"), electrolyte("Et4NOTs"), solvent("DMF"), 18.0, 3.4, 13.0,
+                                              0.5])
+    assert from_scratch.hidden_failure(task, [anode("RVC"), electrolyte("KOAc"), solvent("MeOH"), 23.0, 3.3, 21.0,
+                                              0.5])
+    assert not from_scratch.hidden_failure(task, [anode("RVC"), electrolyte("KOAc"), solvent("MeOH"), 21.0, 3.3,
+                                                  21.0, 0.5])
+
+
 def test_a_short_campaign_counts_its_failures_and_keeps_the_best_success():
     name, seed, failed, late, best = from_scratch.run(("m_coupling", 0, True, 6, 0.0))
     assert (name, seed) == ("m_coupling", 0) and 0 <= late <= failed <= 6
