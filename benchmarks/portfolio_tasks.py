@@ -740,6 +740,16 @@ class Electrochem(Task):
         return 2.5 + EC_GAP * j / cls.conductivity(electrolyte, solvent, T)
 
     @staticmethod
+    def allowed(anode, electrolyte, solvent):
+        """Whether the combination is not one of the pairs that do not work."""
+        return (electrolyte, solvent) not in EC_FORBIDDEN and (anode, solvent) not in EC_FORBIDDEN
+
+    @staticmethod
+    def warmest(solvent):
+        """The highest temperature allowed in the solvent (deg C): 10 below its boiling point."""
+        return EC_SOLVENTS[solvent][2] - 10.0
+
+    @staticmethod
     def hours(j, charge, conc):
         """The run time: `charge` F per mole of substrate at `conc` M in the cell, at current density j."""
         return charge * FARADAY * conc * EC_VOLUME * 1e-3 / (j * 1e-3 * EC_AREA) / 3600.0
@@ -747,8 +757,8 @@ class Electrochem(Task):
     def feasible(self, x):
         anode, electrolyte, solvent = self.names(x)
         j, charge, T, conc = x[3], x[4], x[5], x[6]
-        return ((electrolyte, solvent) not in EC_FORBIDDEN and (anode, solvent) not in EC_FORBIDDEN
-                and T <= EC_SOLVENTS[solvent][2] - 10.0 and self.volts(electrolyte, solvent, j, T) <= EC_MAX_VOLTS
+        return (self.allowed(anode, electrolyte, solvent) and T <= self.warmest(solvent)
+                and self.volts(electrolyte, solvent, j, T) <= EC_MAX_VOLTS
                 and self.hours(j, charge, conc) <= EC_MAX_HOURS)
 
     def objective(self, x):
@@ -788,15 +798,16 @@ class Electrochem(Task):
         best = math.inf
         for combination in itertools.product(range(len(self.anodes)), range(len(EC_ELECTROLYTES)),
                                              range(len(self.solvents))):
-            anode, electrolyte, solvent = self.names(combination)
-            if (electrolyte, solvent) in EC_FORBIDDEN or (anode, solvent) in EC_FORBIDDEN:
+            names = self.names(combination)
+            if not self.allowed(*names):
                 continue
+            electrolyte, solvent = names[1:]
 
             def volts(u, electrolyte=electrolyte, solvent=solvent):
                 return EC_MAX_VOLTS - self.volts(electrolyte, solvent, u[0], u[2])
 
             def boiling(u, solvent=solvent):
-                return EC_SOLVENTS[solvent][2] - 10.0 - u[2]
+                return self.warmest(solvent) - u[2]
 
             def value(u, combination=combination):
                 return self.objective(list(combination) + list(u))
