@@ -143,6 +143,44 @@ def test_the_hidden_rules_of_the_electrochemistry_fail_dmf_and_high_current_only
                                                   21.0, 0.5])
 
 
+def test_the_amide_coupling_s_best_reagent_needs_one_base_and_misleads_on_average():
+    task = portfolio_tasks.TASKS["m_amide"]()
+    reagent, base, solvent = task.reagents.index, portfolio_tasks.AM_BASES.index, task.solvents.index
+    best = [reagent("T3P"), base("pyridine"), solvent("MeCN"), 1.43, 3.0, 7.0, 8.8]  # SLSQP's best, rounded
+    assert task.feasible(best) and not from_scratch.hidden_failure(task, best)
+    # the stored reference (SLSQP from 40 random starts per combination; a fine grid around the best agrees to 5e-5)
+    # is at least as good as the rounded best point and within 0.001 of it
+    assert 0.0 <= task.objective(best) - from_scratch.REFERENCES["m_amide"] < 1e-3
+    # T3P is poor with any other base: pyridine is what makes it fast
+    for other in ("DIPEA", "NMM", "collidine"):
+        assert task.objective([reagent("T3P"), base(other), solvent("MeCN")] + best[3:]) > task.objective(best) + 0.3
+    # HATU, with every base, is better than T3P without pyridine at the same conditions (the main effect misleads) ...
+    for other in ("DIPEA", "NMM", "collidine"):
+        hatu = [reagent("HATU"), base(other), solvent("MeCN"), 1.2, 3.0, 7.0, 8.8]
+        assert task.feasible(hatu)
+        assert task.objective(hatu) < task.objective([reagent("T3P"), base(other), solvent("MeCN")] + best[3:])
+    # ... and HATU's best family (collidine, cold) stays more than 0.1 below the best
+    assert task.objective([reagent("HATU"), base("collidine"), solvent("DCM"), 1.18, 2.0, -5.8, 11.3]) > \
+        task.objective(best) + 0.1
+    # known constraints: the cost caps HATU's equivalents, the uronium reagents need two equivalents of base, DCM
+    # boils at 40 deg C, HATU does not dissolve in EtOAc
+    assert not task.feasible([reagent("HATU"), base("NMM"), solvent("DMF"), 1.3, 2.0, 0.0, 4.0])
+    assert not task.feasible([reagent("COMU"), base("NMM"), solvent("DMF"), 1.2, 1.9, 0.0, 4.0])
+    assert task.feasible([reagent("T3P"), base("NMM"), solvent("DMF"), 1.2, 1.0, 0.0, 4.0])
+    assert not task.feasible([reagent("T3P"), base("pyridine"), solvent("DCM"), 1.4, 3.0, 31.0, 4.0])
+    assert not task.feasible([reagent("HATU"), base("DIPEA"), solvent("EtOAc"), 1.2, 2.0, 0.0, 4.0])
+
+
+def test_the_hidden_rules_of_the_amide_coupling_fail_cold_dmf_and_warm_comu_only():
+    task = portfolio_tasks.TASKS["m_amide"]()
+    reagent, base, solvent = task.reagents.index, portfolio_tasks.AM_BASES.index, task.solvents.index
+    assert from_scratch.hidden_failure(task, [reagent("HATU"), base("NMM"), solvent("DMF"), 1.2, 2.0, -15.0, 12.0])
+    assert not from_scratch.hidden_failure(task, [reagent("HATU"), base("NMM"), solvent("DMF"), 1.2, 2.0, 1.0, 12.0])
+    assert from_scratch.hidden_failure(task, [reagent("COMU"), base("NMM"), solvent("MeCN"), 1.2, 2.0, 26.0, 2.0])
+    assert not from_scratch.hidden_failure(task, [reagent("HATU"), base("NMM"), solvent("MeCN"), 1.2, 2.0, 26.0,
+                                                  2.0])
+
+
 def test_a_short_campaign_counts_its_failures_and_keeps_the_best_success():
     name, seed, failed, late, best = from_scratch.run(("m_coupling", 0, True, 6, 0.0))
     assert (name, seed) == ("m_coupling", 0) and 0 <= late <= failed <= 6
