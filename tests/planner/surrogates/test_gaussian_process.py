@@ -415,6 +415,27 @@ def test_a_fit_retried_from_the_prior_draws_the_length_scales_that_have_one_with
         assert (new >= Features(space).lengthscale_floors).all() and (new <= gp_module.LENGTHSCALE_BOUNDS[1]).all()
 
 
+def test_a_retry_from_the_prior_on_ten_inputs_sets_draws_beyond_the_bounds_just_inside_them():
+    """Ten continuous inputs: the prior's median (~13) is near the upper bound (20), so a draw of all ten within the
+    bounds is rare, and BoTorch, which draws again on every out-of-bounds error, gave up after 100 draws and failed
+    the ask. Each draw is now taken as it is within the bounds and just inside them beyond."""
+    space = SearchSpace.from_config([{"name": f"x{i}", "type": "continuous", "low": 0, "high": 1} for i in range(10)])
+    X = np.random.default_rng(0).random((20, 10))
+    gp = GaussianProcess(space, X, X.sum(axis=1), seed=0)
+    (kernel,) = [m for m in gp.model.covar_module.modules() if isinstance(m, MaternKernel)]
+    low, high = gp_module.LENGTHSCALE_BOUNDS
+    at_bound = 0
+    for seed in range(5):
+        torch.manual_seed(seed)
+        sample_all_priors(gp.model)  # raised "Failed to sample a feasible parameter value" before
+        drawn = kernel.lengthscale.detach().ravel()
+        assert torch.isfinite(kernel.raw_lengthscale).all()
+        assert (drawn > low).all() and (drawn < high).all()
+        at_bound += int((drawn > 0.999 * high).sum())
+        assert len(torch.unique(drawn)) > 3  # drawn, not set to one value
+    assert at_bound > 0  # some draws were beyond the upper bound (P ~ 0.4 each, 50 draws)
+
+
 def test_a_fit_that_explains_the_data_as_noise_is_repeated_from_short_length_scales(monkeypatch):
     """Without the length-scale prior, from BoTorch's start the marginal likelihood of these 8 points of a smooth bowl
     ends in its all-noise optimum (a near-constant model, whose expected improvement kept m_coupling's campaigns on

@@ -50,6 +50,9 @@ DESCRIPTOR_LENGTHSCALE_MIN = 0.2
 # A discrete parameter's ordinal positions have no prior: there it cost the paper's Michalewicz with unknown
 # constraints 21.7 -> 24.9 evaluations (30 seeds).
 LENGTHSCALE_PRIOR_LOC, LENGTHSCALE_PRIOR_SCALE = math.sqrt(2.0), math.sqrt(3.0)
+# A length scale drawn from that prior beyond its bounds is set this share of the bounds' span inside them
+# (`set_lengthscales_of`): exactly at a bound the constraint's inverse transform is infinite.
+PRIOR_DRAW_MARGIN = 1e-6
 # Largest number of candidates in one posterior evaluation.
 CHUNK = 4096
 # Hyperparameters are fitted to at most FIT_MAX observations (each marginal-likelihood evaluation costs n^3: a fit took
@@ -358,10 +361,17 @@ def lengthscales_of(inputs: list[int], kernel: MaternKernel) -> torch.Tensor:
 
 def set_lengthscales_of(inputs: list[int], kernel: MaternKernel, value: torch.Tensor) -> None:
     """Set the length scales of some of a kernel's inputs, the others kept: BoTorch's fit, when no attempt converges,
-    retries from length scales drawn from the prior (`sample_all_priors`), which sets them through this. A value
-    outside the bounds raises GPyTorch's out-of-bounds error, on which BoTorch draws again."""
+    retries from length scales drawn from the prior (`sample_all_priors`), which sets them through this. A drawn value
+    beyond the bounds is taken just inside them: raising GPyTorch's out-of-bounds error made BoTorch draw every length
+    scale again, up to 100 times, and then fail the ask, and with the prior's median near the upper bound a draw of
+    eight or more inputs all within it is rare (m_electrochem, a kernel over nine inputs: "Failed to sample a feasible
+    parameter value from the prior after 100 attempts")."""
     lengthscale = kernel.lengthscale.detach().clone()
-    lengthscale[..., inputs] = value.to(lengthscale)
+    constraint = kernel.raw_lengthscale_constraint
+    low = constraint.lower_bound.to(lengthscale).expand_as(lengthscale)[..., inputs]
+    high = constraint.upper_bound.to(lengthscale).expand_as(lengthscale)[..., inputs]
+    margin = PRIOR_DRAW_MARGIN * (high - low)
+    lengthscale[..., inputs] = torch.minimum(torch.maximum(value.to(lengthscale), low + margin), high - margin)
     kernel.lengthscale = lengthscale
 
 
