@@ -832,12 +832,12 @@ class Amide(Task):
     temperature 10 deg C below the solvent's boiling point, the reagent's cost per mole of acid (caps HATU at 1.25
     equivalents), two equivalents of base at least with the uronium reagents, three reagent / solvent pairs that do
     not dissolve. The activated acid couples, epimerizes (faster with strong bases, in polar solvents, and more
-    steeply with temperature) or is lost (N-acylurea, hydrolysis); the value counts the epimer twice (it must be
-    removed) and subtracts the reagent's price, the hours and the base. New in the portfolio: the reagent that is best
-    on average misleads. HATU is good with any base (0.55-0.65 at low temperature); T3P is poor with every base but
-    pyridine (below 0.05 with DIPEA and NMM, 0.36 with collidine), and with pyridine it is the best in every solvent
-    (0.75-0.785, the best T3P / pyridine / MeCN at 7 deg C and 3 equivalents of pyridine). 29 of the 88 allowed
-    combinations give less than 0.05."""
+    steeply with temperature) or is lost (N-acylurea, hydrolysis); the value counts what epimerized or was lost
+    twice against the product (the epimer must be removed) and subtracts the reagent's price, the hours and the
+    base. New in the portfolio: the reagent that is best on average misleads. HATU is good with any base (0.51-0.65
+    at low temperature); T3P is poor with every base but pyridine (below 0.05 with DIPEA and NMM, 0.28-0.39 with
+    collidine), and with pyridine it is the best in every solvent (0.75-0.785, the best T3P / pyridine / MeCN at 7
+    deg C and 3 equivalents of pyridine). 29 of the 88 allowed combinations give less than 0.05."""
     name, family, budget = "m_amide", "mixed_heldout", 40
 
     def __init__(self):
@@ -877,7 +877,7 @@ class Amide(Task):
         converted = (1 - math.exp(-total * hours)) * min(1.0, AM_EFFICIENCY[reagent] * equiv)
         if reagent in AM_URONIUM:
             converted *= 1 - 0.3 * max(0.0, equiv - 1.1)  # the excess guanylates the amine
-        lost = 1 - k / total  # epimerized or lost of what reacted
+        lost = 1 - k / total  # the share of what reacted that epimerized or was lost: counted twice
         return -(converted * (1 - 2 * lost) - 0.025 * price * equiv - 0.004 * hours - 0.01 * base_equiv)
 
     def reference(self, starts: int = 40) -> float:
