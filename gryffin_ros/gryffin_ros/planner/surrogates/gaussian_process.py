@@ -364,8 +364,9 @@ def set_lengthscales_of(inputs: list[int], kernel: MaternKernel, value: torch.Te
     retries from length scales drawn from the prior (`sample_all_priors`), which sets them through this. A drawn value
     beyond the bounds is taken just inside them: raising GPyTorch's out-of-bounds error made BoTorch draw every length
     scale again, up to 100 times, and then fail the ask, and with the prior's median near the upper bound a draw of
-    eight or more inputs all within it is rare (m_electrochem, a kernel over nine inputs: "Failed to sample a feasible
-    parameter value from the prior after 100 attempts")."""
+    eight or more inputs all within it is rare ("Failed to sample a feasible parameter value from the prior after 100
+    attempts" in 7 of 11 m_electrochem campaigns with round thirty's main-effect terms, kernels over six and nine
+    inputs; benchmarks/README.md)."""
     lengthscale = kernel.lengthscale.detach().clone()
     constraint = kernel.raw_lengthscale_constraint
     low = constraint.lower_bound.to(lengthscale).expand_as(lengthscale)[..., inputs]
