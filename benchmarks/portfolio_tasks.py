@@ -855,10 +855,15 @@ class Amide(Task):
         """Whether the combination is not one of the pairs that do not dissolve (the base is free)."""
         return (reagent, solvent) not in AM_FORBIDDEN
 
+    @staticmethod
+    def warmest(solvent):
+        """The highest temperature allowed in the solvent (deg C): 10 below its boiling point."""
+        return AM_SOLVENTS[solvent][1] - 10.0
+
     def feasible(self, x):
         reagent, base, solvent = self.names(x)
         equiv, base_equiv, T = x[3], x[4], x[5]
-        return (self.allowed(reagent, base, solvent) and T <= AM_SOLVENTS[solvent][1] - 10.0
+        return (self.allowed(reagent, base, solvent) and T <= self.warmest(solvent)
                 and AM_REAGENTS[reagent][1] * equiv <= AM_MAX_COST
                 and (reagent not in AM_URONIUM or base_equiv >= 2.0))
 
@@ -886,7 +891,7 @@ class Amide(Task):
         def limits(reagent, base, solvent):
             if not self.allowed(reagent, base, solvent):
                 return None
-            out = [lambda u: AM_SOLVENTS[solvent][1] - 10.0 - u[2],
+            out = [lambda u: self.warmest(solvent) - u[2],
                    lambda u: AM_MAX_COST - AM_REAGENTS[reagent][1] * u[0]]
             return out + ([lambda u: u[1] - 2.0] if reagent in AM_URONIUM else [])
 
