@@ -4,7 +4,7 @@ Optionally with hidden failures (`--hidden`): experiments that fail by rules the
 failed (`None`). With `--failure-rate R` each experiment also fails with probability R, wherever it is (a blocked line,
 a cracked vial; the draws of failing_region.py's option).
 
-Hidden failures (m_coupling, m_oxidation, m_hydrogenation, m_crystallization, m_electrochem and m_amide), touching
+Hidden failures (m_coupling, m_oxidation, m_hydrogenation, m_crystallization, m_electrochem, m_amide and m_raft), touching
 no task's best combination, so the references stay the optima:
 - m_coupling: every experiment with Cs2CO3 fails (the base precipitates) and every one in DMF above 110 deg C (the
   solvent decomposes); the best, PPh3 / K3PO4 / EtOH, runs at most at 73 deg C by the known constraint.
@@ -19,6 +19,9 @@ no task's best combination, so the references stay the optima:
   overheats); the best runs at 13 mA/cm2, every combination worth more than 0.3 below 17 mA/cm2.
 - m_amide: every experiment in DMF below 0 deg C fails (the amine's salt crystallizes) and every one with COMU above
   25 deg C (the reagent decomposes); the best runs in MeCN at 7 deg C, T3P / pyridine in DMF at 2 deg C.
+- m_raft: every experiment with DBTTC fails (a batch that hydrolysed: the runner-up agent) and every one above 3.3 M
+  and 70 deg C (the solution gels and the stirrer stalls); the best runs at 2.8 M and 78 deg C, the best in dioxane
+  (3.6 M, 72-77 deg C) fails.
 
     python -m benchmarks.from_scratch [--tasks m_coupling] [--seeds 12] [--hidden] [--failure-rate R] [--processes 2]
 
@@ -50,7 +53,8 @@ REFERENCES = {"m_coupling": -0.7402339145154431, "m_solvent": -0.939240490607999
               "m_amination": -0.7898500948054701, "m_photoredox": -0.8558160481769198,
               "m_oxidation": -0.8164543183802141, "m_biocatalysis": -0.6787806044424859,
               "m_hydrogenation": -0.8891914040803628, "m_crystallization": -0.6689293085972873,
-              "m_electrochem": -0.5237772734915087, "m_amide": -0.7846779939655112}
+              "m_electrochem": -0.5237772734915087, "m_amide": -0.7846779939655112,
+              "m_raft": -0.5242399553636078}
 
 
 # the hidden rules by task (above): whether the experiment x (a harness point) of the task fails
@@ -64,6 +68,7 @@ HIDDEN_RULES: dict[str, Callable] = {
     "m_electrochem": lambda task, x: task.solvents[int(x[2])] == "DMF" or x[3] > 22.0,
     "m_amide": lambda task, x: ((task.solvents[int(x[2])] == "DMF" and x[5] < 0.0)
                                 or (task.reagents[int(x[0])] == "COMU" and x[5] > 25.0)),
+    "m_raft": lambda task, x: task.agents[int(x[0])] == "DBTTC" or (x[6] > 3.3 and x[4] > 70.0),
 }
 HIDDEN = tuple(HIDDEN_RULES)  # the tasks with hidden failures
 

@@ -899,6 +899,117 @@ class Amide(Task):
 
 
 # ----------------------------------------------------------------------------------------------------------------
+# RAFT polymerization of methyl acrylate to a target chain length (degree of polymerization 200): the initiator's
+# half-life sets the temperature that suits it, so each initiator has its own best conditions, and the chain-transfer
+# agent that controls best slows the polymerization of acrylates (retardation) or falls apart when hot
+
+RAFT_AGENTS = {"DDMAT": (1.7, 0.0), "CDTPA": (1.9, 0.0), "DBTTC": (1.3, 0.0), "CPADB": (2.3, 1.0),
+               "xanthate": (0.0, 0.0)}  # log10 of the transfer constant to methyl acrylate, retardation (L/mmol)
+RAFT_INITIATORS = {"V-70": (30.0,), "V-65": (51.0,), "AIBN": (65.0,), "V-601": (66.0,),
+                   "ACVA": (69.0,)}  # the temperature (deg C) at which half decomposes in 10 h
+RAFT_SOLVENTS = {"dioxane": (101.0, 3.0), "toluene": (111.0, 2.0), "DMF": (153.0, 1.0), "anisole": (154.0, 1.2),
+                 "EtOAc": (77.0, 0.6)}  # boiling point (deg C), transfer constant to the solvent (1e-4)
+RAFT_FORBIDDEN = {("ACVA", "toluene"), ("ACVA", "anisole"), ("V-70", "DMF")}  # initiator, solvent
+RAFT_EFFICIENCY = {"V-70": 0.45, "V-65": 0.6, "AIBN": 0.6, "V-601": 0.7, "ACVA": 0.55}
+RAFT_DECOMPOSITION = {"DDMAT": (0.002, 90.0), "CDTPA": (0.02, 70.0), "DBTTC": (0.002, 90.0),
+                      "CPADB": (0.03, 60.0), "xanthate": (0.001, 100.0)}  # agent lost per hour at (deg C)
+RAFT_SOLVENT_KP = {"dioxane": 1.0, "toluene": 0.85, "DMF": 1.25, "anisole": 0.95, "EtOAc": 0.9}
+RAFT_TARGET_DP = 200.0
+RAFT_MAX_FLUX = 0.3  # mmol/L/h of radicals at the start: what the jacket can cool
+RAFT_HALF_LIFE_EA, RAFT_PROPAGATION_EA = 125e3, 17.3e3  # J/mol
+RAFT_RATE = 1.1  # sets the rate: AIBN at 65 deg C, 5 agents per initiator, 2 M, reaches about 75 % in 10 h
+
+
+class Raft(Task):
+    """RAFT polymerization of methyl acrylate to 200 units per chain (held out): the chain-transfer agent (categorical,
+    with descriptors: log transfer constant, retardation), the initiator (categorical, with descriptors: the 10-hour
+    half-life temperature) and the solvent (categorical, with descriptors: boiling point, transfer to the solvent) +
+    agent per initiator, temperature, time and monomer concentration (continuous). Known constraints: the temperature
+    10 deg C below the solvent's boiling point and at most 30 deg C above the initiator's 10-hour temperature (a
+    runaway limit), the radical flux at the start that the jacket can cool, three initiator / solvent pairs that do
+    not dissolve or react. Conversion follows the dead-end equation of a decaying initiator; the value counts what
+    converted into living chains, less the dispersity's excess (a transfer constant too low, dead chains, the gel
+    effect at high concentration) and the hours. New in the portfolio: each initiator has its own best temperature
+    (the categorical option moves the continuous optimum), and the best agent by transfer constant (the dithiobenzoate
+    CPADB) retards and decomposes when warm."""
+    name, family, budget = "m_raft", "mixed_heldout", 40
+
+    def __init__(self):
+        self.agents, self.initiators, self.solvents = list(RAFT_AGENTS), list(RAFT_INITIATORS), list(RAFT_SOLVENTS)
+        self.params = [CatParam("agent", self.agents, RAFT_AGENTS),
+                       CatParam("initiator", self.initiators, RAFT_INITIATORS),
+                       CatParam("solvent", self.solvents, RAFT_SOLVENTS), Param("ratio", "float", 2.0, 20.0),
+                       Param("T", "float", 30.0, 100.0), Param("hours", "float", 1.0, 24.0),
+                       Param("conc", "float", 1.0, 4.0)]
+
+    def names(self, x):
+        return self.agents[int(x[0])], self.initiators[int(x[1])], self.solvents[int(x[2])]
+
+    @staticmethod
+    def allowed(agent, initiator, solvent):
+        """Whether the initiator dissolves in (and does not react with) the solvent (the agent is free)."""
+        return (initiator, solvent) not in RAFT_FORBIDDEN
+
+    @staticmethod
+    def warmest(initiator, solvent):
+        """The highest temperature allowed (deg C): 10 below the solvent's boiling point, 30 above the initiator's
+        10-hour temperature."""
+        return min(RAFT_SOLVENTS[solvent][0] - 10.0, RAFT_INITIATORS[initiator][0] + 30.0)
+
+    @staticmethod
+    def decomposition(initiator, T):
+        """The initiator's decomposition rate constant (1/h) at T (deg C)."""
+        return math.log(2) / 10.0 * math.exp(-RAFT_HALF_LIFE_EA / 8.314 * (
+            1 / (T + 273.15) - 1 / (RAFT_INITIATORS[initiator][0] + 273.15)))
+
+    def flux(self, initiator, ratio, T, conc):
+        """The radical flux at the start (mmol/L/h): 2 f k_d [I]_0."""
+        initiator_mM = 1000.0 * conc / RAFT_TARGET_DP / ratio
+        return 2 * RAFT_EFFICIENCY[initiator] * self.decomposition(initiator, T) * initiator_mM
+
+    def feasible(self, x):
+        agent, initiator, solvent = self.names(x)
+        ratio, T, conc = x[3], x[4], x[6]
+        return (self.allowed(agent, initiator, solvent) and T <= self.warmest(initiator, solvent)
+                and self.flux(initiator, ratio, T, conc) <= RAFT_MAX_FLUX)
+
+    def objective(self, x):
+        agent, initiator, solvent = self.names(x)
+        ratio, T, hours, conc = x[3], x[4], x[5], x[6]
+        log_transfer, retardation = RAFT_AGENTS[agent]
+        agent_mM = 1000.0 * conc / RAFT_TARGET_DP
+        initiator_mM = agent_mM / ratio
+        kd = self.decomposition(initiator, T)
+        f = RAFT_EFFICIENCY[initiator]
+        kp = RAFT_SOLVENT_KP[solvent] * arrhenius(RAFT_PROPAGATION_EA, T) / arrhenius(RAFT_PROPAGATION_EA, 65.0)
+        # dead-end polymerization: ln 1/(1 - x) = 2 k_p (f [I]_0 / (k_d k_t))^1/2 (1 - e^(-k_d t / 2)), retarded
+        drive = RAFT_RATE * kp * math.sqrt(f * initiator_mM / kd) * (1 - math.exp(-kd * hours / 2))
+        drive /= 1 + retardation * agent_mM / 10.0
+        conversion = 1 - math.exp(-drive)
+        # dead chains: those the initiator started (terminated), the agent decomposed, the solvent took over
+        started = 2 * f * initiator_mM * (1 - math.exp(-kd * hours))
+        rate, at = RAFT_DECOMPOSITION[agent]
+        decomposed = 1 - math.exp(-rate * hours * math.exp(0.08 * (T - at)))
+        solvent_conc = max(0.5, 9.0 - 1.1 * conc)  # mol/L of solvent beside the monomer
+        transferred = RAFT_SOLVENTS[solvent][1] * 1e-4 * solvent_conc / conc * RAFT_TARGET_DP * conversion
+        dead = min(1.0, started / (agent_mM + started) + decomposed + transferred)
+        dispersity = (1 + 1 / RAFT_TARGET_DP + (2 - conversion) / max(conversion, 1e-6) / 10 ** log_transfer
+                      + 0.5 * dead + 0.5 * (conc / 4.0) ** 2 * conversion ** 3)
+        return -(conversion * (1 - dead) - 0.5 * (dispersity - 1) - 0.012 * hours)
+
+    def reference(self, starts: int = 40) -> float:
+        """The best over every allowed combination of SLSQP from `starts` random points each
+        (`multistart_reference`), the temperature and flux limits as its constraints."""
+        def limits(agent, initiator, solvent):
+            if not self.allowed(agent, initiator, solvent):
+                return None
+            return [lambda u: self.warmest(initiator, solvent) - u[1],
+                    lambda u: RAFT_MAX_FLUX - self.flux(initiator, u[0], u[1], u[3])]
+
+        return multistart_reference(self, limits, starts)
+
+
+# ----------------------------------------------------------------------------------------------------------------
 # reaction kinetics in a flow reactor
 
 KINETIC_SOLVENTS = {"MeCN": (82.0, 1.0), "toluene": (111.0, 0.55), "DMSO": (189.0, 1.6)}  # bp, rate factor
@@ -1034,4 +1145,4 @@ def dense_reference(task, cont_steps: int, polish_from: int = 20) -> float:
 FAMILIES = ("smooth2", "smooth6", "smooth10", "mixed", "kinetics", "mixed_heldout")
 TASKS = {t.name: t for t in (Camel2, Rosenbrock2, Hartmann6, Ellipsoid6, Ellipsoid10, Styblinski10, Solvent,
                              Catalyst, Discrete, Coupling, Consecutive, Parallel, Amination, Photoredox,
-                             Oxidation, Biocatalysis, Hydrogenation, Crystallization, Electrochem, Amide)}
+                             Oxidation, Biocatalysis, Hydrogenation, Crystallization, Electrochem, Amide, Raft)}
