@@ -181,6 +181,44 @@ def test_the_hidden_rules_of_the_amide_coupling_fail_cold_dmf_and_warm_comu_only
                                                   2.0])
 
 
+def test_each_initiator_of_the_raft_polymerization_has_its_own_temperature():
+    task = portfolio_tasks.TASKS["m_raft"]()
+    agent, initiator, solvent = task.agents.index, task.initiators.index, task.solvents.index
+    best = [agent("DDMAT"), initiator("ACVA"), solvent("DMF"), 11.0, 78.0, 7.5, 2.76]  # SLSQP's best, rounded
+    assert task.feasible(best) and not from_scratch.hidden_failure(task, best)
+    # the stored reference (SLSQP from 40 random starts per combination) is at least as good as the rounded best
+    # point and within 0.001 of it
+    assert 0.0 <= task.objective(best) - from_scratch.REFERENCES["m_raft"] < 1e-3
+    # V-65 (10-hour temperature 51 deg C) is good at 57 deg C, within 0.1 of the best; at the best's 78 deg C it
+    # releases more radicals than the jacket can cool (a known constraint), and ACVA at 57 deg C is poor
+    v65 = [agent("DDMAT"), initiator("V-65"), solvent("DMF"), 11.0, 57.0, 9.1, 2.98]
+    assert task.feasible(v65) and task.objective(v65) < task.objective(best) + 0.1
+    assert not task.feasible(v65[:4] + [78.0] + v65[5:])
+    assert task.objective(best[:4] + [57.0] + best[5:]) > task.objective(best) + 0.2
+    # the agent with the highest transfer constant (the dithiobenzoate CPADB) retards: more than 0.5 worse
+    assert task.objective([agent("CPADB")] + best[1:]) > task.objective(best) + 0.5
+    # known constraints: EtOAc boils at 77 deg C, V-70 stays within 30 deg C of its 10-hour temperature (30), ACVA
+    # does not dissolve in toluene, and the radical flux at the start
+    assert not task.feasible([agent("DDMAT"), initiator("AIBN"), solvent("EtOAc"), 10.0, 68.0, 8.0, 2.5])
+    assert task.feasible([agent("DDMAT"), initiator("AIBN"), solvent("EtOAc"), 10.0, 66.0, 8.0, 2.5])
+    assert not task.feasible([agent("DDMAT"), initiator("V-70"), solvent("dioxane"), 10.0, 61.0, 8.0, 2.5])
+    assert not task.feasible([agent("DDMAT"), initiator("ACVA"), solvent("toluene"), 10.0, 70.0, 8.0, 2.5])
+    assert not task.feasible([agent("DDMAT"), initiator("ACVA"), solvent("DMF"), 2.0, 85.0, 8.0, 4.0])
+
+
+def test_the_hidden_rules_of_the_raft_polymerization_fail_one_agent_and_hot_concentrated_runs_only():
+    task = portfolio_tasks.TASKS["m_raft"]()
+    agent, initiator, solvent = task.agents.index, task.initiators.index, task.solvents.index
+    assert from_scratch.hidden_failure(task, [agent("DBTTC"), initiator("AIBN"), solvent("DMF"), 11.0, 60.0, 8.0,
+                                              2.0])
+    assert from_scratch.hidden_failure(task, [agent("DDMAT"), initiator("AIBN"), solvent("dioxane"), 11.0, 72.0,
+                                              8.0, 3.4])
+    assert not from_scratch.hidden_failure(task, [agent("DDMAT"), initiator("AIBN"), solvent("dioxane"), 11.0,
+                                                  68.0, 8.0, 3.4])
+    assert not from_scratch.hidden_failure(task, [agent("DDMAT"), initiator("AIBN"), solvent("dioxane"), 11.0,
+                                                  72.0, 8.0, 3.2])
+
+
 def test_a_short_campaign_counts_its_failures_and_keeps_the_best_success():
     name, seed, failed, late, best = from_scratch.run(("m_coupling", 0, True, 6, 0.0))
     assert (name, seed) == ("m_coupling", 0) and 0 <= late <= failed <= 6
