@@ -993,8 +993,9 @@ class Raft(Task):
         solvent_conc = max(0.5, 9.0 - 1.1 * conc)  # mol/L of solvent beside the monomer
         transferred = RAFT_SOLVENTS[solvent][1] * 1e-4 * solvent_conc / conc * RAFT_TARGET_DP * conversion
         dead = min(1.0, started / (agent_mM + started) + decomposed + transferred)
-        dispersity = (1 + 1 / RAFT_TARGET_DP + (2 - conversion) / max(conversion, 1e-6) / 10 ** log_transfer
-                      + 0.5 * dead + 0.5 * (conc / 4.0) ** 2 * conversion ** 3)
+        # Mueller's excess from a finite transfer constant, at most that of a free-radical polymerization (2)
+        uncontrolled = min(1.0, (2 - conversion) / max(conversion, 1e-6) / 10 ** log_transfer)
+        dispersity = 1 + 1 / RAFT_TARGET_DP + uncontrolled + 0.5 * dead + 0.5 * (conc / 4.0) ** 2 * conversion ** 3
         return -(conversion * (1 - dead) - 0.5 * (dispersity - 1) - 0.012 * hours)
 
     def reference(self, starts: int = 40) -> float:
