@@ -4,8 +4,8 @@ Optionally with hidden failures (`--hidden`): experiments that fail by rules the
 failed (`None`). With `--failure-rate R` each experiment also fails with probability R, wherever it is (a blocked line,
 a cracked vial; the draws of failing_region.py's option).
 
-Hidden failures (m_coupling, m_oxidation, m_hydrogenation, m_crystallization, m_electrochem, m_amide and m_raft), touching
-no task's best combination, so the references stay the optima:
+Hidden failures (m_coupling, m_oxidation, m_hydrogenation, m_crystallization, m_electrochem, m_amide and m_raft),
+touching no task's best combination, so the references stay the optima:
 - m_coupling: every experiment with Cs2CO3 fails (the base precipitates) and every one in DMF above 110 deg C (the
   solvent decomposes); the best, PPh3 / K3PO4 / EtOH, runs at most at 73 deg C by the known constraint.
 - m_oxidation: every experiment with AZADO fails (a degraded batch: the near-duplicate of the best nitroxyl, ABNO) and
