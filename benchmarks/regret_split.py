@@ -30,7 +30,7 @@ from benchmarks import portfolio_tasks  # noqa: E402
 from benchmarks.from_scratch import REFERENCES  # noqa: E402
 
 # differential evolution per combination: its population (per continuous condition) and generations; a point that
-# breaks a known constraint scores PENALTY (every task's values are within +-100 of 0 where feasible)
+# breaks a known constraint scores PENALTY (far above any feasible value of the tasks of from_scratch.REFERENCES)
 POPULATION, GENERATIONS, PENALTY = 25, 300, 1e3
 CLOSE = 0.01  # a combination this close to the best counts as the best one
 
