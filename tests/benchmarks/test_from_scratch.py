@@ -219,6 +219,48 @@ def test_the_hidden_rules_of_the_raft_polymerization_fail_one_agent_and_hot_conc
                                                   72.0, 8.0, 3.2])
 
 
+def test_each_catalyst_of_the_ring_closing_metathesis_has_its_own_temperature():
+    task = portfolio_tasks.TASKS["m_metathesis"]()
+    catalyst, solvent, additive = task.catalysts.index, task.solvents.index, task.additives.index
+    best = [catalyst("M73"), solvent("PhCF3"), additive("BQ"), 1.23, 68.9, 0.00485, 5.3]  # SLSQP's best, rounded
+    assert task.feasible(best) and not from_scratch.hidden_failure(task, best)
+    # the stored reference (SLSQP from 40 random starts per combination) is at least as good as the rounded best
+    # point and within 0.001 of it
+    assert 0.0 <= task.objective(best) - from_scratch.REFERENCES["m_metathesis"] < 1e-3
+    # the fast-initiating G-II is better at 55 deg C than the slow M73, whose best is 14 deg C warmer
+    cool = best[:4] + [55.0] + best[5:]
+    assert task.objective([catalyst("G-II")] + cool[1:]) < task.objective(cool) - 0.05
+    assert task.objective([catalyst("G-II")] + cool[1:]) > task.objective(best) + 0.05
+    # a Hoveyda-type catalyst is best with Ti(OiPr)4, within 0.01 of the best; M73 with it is not
+    hoveyda = [catalyst("HG-II"), solvent("PhCF3"), additive("Ti(OiPr)4"), 1.03, 54.0, 0.0052, 4.9]
+    assert task.feasible(hoveyda) and task.objective(hoveyda) < task.objective(best) + 0.01
+    assert task.objective(hoveyda) < task.objective([catalyst("HG-II")] + best[1:3] + hoveyda[3:]) - 0.01
+    # dilution: a more concentrated run (the least catalyst that dissolves) makes more oligomer, and Grubbs I is poor
+    # whatever it runs with
+    concentrated = best[:3] + [0.5, 68.9, 0.012, 5.3]
+    assert task.feasible(concentrated) and task.objective(concentrated) > task.objective(best) + 0.05
+    assert task.objective([catalyst("G-I")] + best[1:]) > task.objective(best) + 0.3
+    # known constraints: DCM boils at 40 deg C, the catalyst's solubility (loading x concentration), Ti(OiPr)4 does
+    # not go with EtOAc nor CuI with toluene
+    assert not task.feasible([catalyst("G-II"), solvent("DCM"), additive("BQ"), 1.0, 45.0, 0.005, 5.0])
+    assert task.feasible([catalyst("G-II"), solvent("DCM"), additive("BQ"), 1.0, 40.0, 0.005, 5.0])
+    assert not task.feasible(best[:3] + [2.0, 68.9, 0.005, 5.3])
+    assert task.feasible(best[:3] + [2.0, 68.9, 0.0025, 5.3])
+    assert not task.feasible([catalyst("M73"), solvent("EtOAc"), additive("Ti(OiPr)4"), 1.0, 60.0, 0.005, 5.0])
+    assert not task.feasible([catalyst("M73"), solvent("toluene"), additive("CuI"), 1.0, 60.0, 0.005, 5.0])
+
+
+def test_the_hidden_rules_of_the_metathesis_fail_one_catalyst_and_hot_runs_only():
+    task = portfolio_tasks.TASKS["m_metathesis"]()
+    catalyst, solvent, additive = task.catalysts.index, task.solvents.index, task.additives.index
+    assert from_scratch.hidden_failure(task, [catalyst("Zhan-1B"), solvent("PhCF3"), additive("BQ"), 1.2, 55.0,
+                                              0.005, 5.0])
+    assert from_scratch.hidden_failure(task, [catalyst("M73"), solvent("toluene"), additive("BQ"), 1.2, 90.0,
+                                              0.005, 5.0])
+    assert not from_scratch.hidden_failure(task, [catalyst("M73"), solvent("toluene"), additive("BQ"), 1.2, 80.0,
+                                                  0.005, 5.0])
+
+
 def test_a_short_campaign_counts_its_failures_and_keeps_the_best_success():
     name, seed, failed, late, best = from_scratch.run(("m_coupling", 0, True, 6, 0.0))
     assert (name, seed) == ("m_coupling", 0) and 0 <= late <= failed <= 6
