@@ -71,6 +71,8 @@ EI_TAIL_SLOPE = 0.01
 COVER_MAX_OPTIONS = 10
 COVER_TRIES = 2
 COVER_STARTS = 32
+# The fewest successful experiments on the incumbent's combination of options for a GP of their own (`Planner._within`).
+WITHIN_LEAST = 4
 
 
 @dataclass
@@ -264,7 +266,8 @@ class Planner(BasePlanner):
         start, exhaustive = self.start_points(rng, incumbent, X)
         if gp is not None:
             self._after_stall(gp, meta)
-            points, notes = self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen, incumbent)
+            points, notes = self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen, incumbent,
+                                             models)
             meta.update(notes)
             return points, [None] * n, meta
         return (*self._propose_kde(n, rng, density, start, exhaustive, feasibility, observed, chosen), meta)
@@ -337,7 +340,7 @@ class Planner(BasePlanner):
 
     def _propose_gp(self, n: int, rng: np.random.Generator, gp: GaussianProcess, start: np.ndarray, exhaustive: bool,
                     feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray,
-                    incumbent: np.ndarray) -> tuple[np.ndarray, dict[str, str]]:
+                    incumbent: np.ndarray, models: Surrogates) -> tuple[np.ndarray, dict[str, str]]:
         """n points by the GP's expected improvement; failed and pending experiments and the batch's earlier proposals
         enter the GP as believed results (kriging believer), so they are not proposed again and a batch spreads out
         without Gryffin's strategies. The acquisition is optimized once per ask; each further point of a batch is the
@@ -345,7 +348,9 @@ class Planner(BasePlanner):
         been run fewer than COVER_TRIES times, a point is the best candidate that holds one (`under_tried`); else,
         when the campaign has settled on one combination of those parameters' options (`settled`), the first point is
         the best result's conditions with one option changed, to a combination not run yet where one is left, else
-        with two (`_swaps`). The second value: the proposals' meta entries that say so."""
+        with two (`_swaps`). When the first point of an ask after an odd number of experiments runs the best result's
+        combination of those options anyway, where in it is decided by a GP of that combination's own experiments
+        (`_within`). The second value: the proposals' meta entries that say so."""
         # failed experiments enter as believed results too: the GP learns nothing of the objective from them, so
         # without this their neighbourhood keeps its expected improvement and only P(feasible) holds the planner back
         failed = observed[np.array([o.failed for o in self.observations], dtype=bool)] if feasibility is not None \
@@ -361,6 +366,11 @@ class Planner(BasePlanner):
         dims = self.space.small_categorical_dims(COVER_MAX_OPTIONS)
         combination = settled(asked[:, dims]) if dims else None
         swaps = None
+        # every other ask only: the campaign's GP must see its own choice within the combination run too, or its
+        # expected improvement there is never answered and it keeps choosing the combination (a plateau with one good
+        # result in a combination: every ask's combination was that one, 9 of 10 asks; round thirty-two)
+        within = (combination is None and not under and not exhaustive and bool(dims) and len(self.space.cont_idx) > 0
+                  and len(observed) % 2 == 1)
         if combination is not None and not under:  # a settled campaign: the first point runs another combination
             swaps = self._swaps(acquisition, dims, combination, incumbent, optimizer, rng, feasibility, asked)
         if under and not exhaustive:
@@ -400,6 +410,15 @@ class Planner(BasePlanner):
                                         "when every combination one option away has run)")
             if x is None:
                 x = self._pick(candidates, alpha, observed, chosen, rng, diverse=False)
+                if within and i == 0 and np.array_equal(np.rint(x[dims]), np.rint(incumbent[dims])):
+                    local = self._within(models, dims, incumbent, candidates, alpha, optimizer, rng, feasibility,
+                                         observed, chosen)
+                    index = select(self.space, local[0], local[1], observed, chosen, diverse=False,
+                                   dist_param=self.config.general.dist_param) if local is not None else None
+                    if index is not None:
+                        x = local[0][index]
+                        notes["within"] = (f"the best result's combination of options, where its own "
+                                           f"{int(local[2])} experiments' GP expects most")
             chosen = np.concatenate([chosen, x[None]])
             points.append(x)
             if i + 1 < n:
@@ -435,6 +454,38 @@ class Planner(BasePlanner):
         if not len(swaps):
             return swaps, np.empty(0)
         return self._candidates(acquisition, swaps, True, optimizer, rng, feasibility)  # scored, not optimized
+
+    def _within(self, models: Surrogates, dims: list[int], incumbent: np.ndarray, candidates: np.ndarray,
+                alpha: np.ndarray, optimizer: AcquisitionOptimizer, rng: np.random.Generator,
+                feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, int] | None:
+        """Candidates within the incumbent's combination of options of `dims`, by the expected improvement of a GP of
+        that combination's successful experiments alone (`SurrogateChoice.local_gaussian_process`; its failed and
+        pending ones believed as in the campaign's GP), optimized with those options pinned from its experiments and
+        the best `candidates` moved into it; their scores, and how many experiments the GP had. None with fewer than
+        WITHIN_LEAST of them. The GP over every combination pools a condition's effect across combinations (m_raft: its
+        length scale of the initiator's descriptor was 5, as if every initiator had one best temperature); one
+        combination's optimum can lie where the others' does not (benchmarks/README.md round thirty-two)."""
+        combination = np.rint(incumbent[dims])
+        rows = np.all(np.rint(models.X[:, dims]) == combination, axis=1)
+        if rows.sum() < WITHIN_LEAST:
+            return None
+        from ..acquisition.gp import GPAcquisition
+
+        local = self.surrogate_choice.local_gaussian_process(models.X, models.successful, models.descriptors, rows)
+        failed = observed[np.array([o.failed for o in self.observations], dtype=bool)] if feasibility is not None \
+            else observed[:0]
+        local.believe(failed[np.all(np.rint(failed[:, dims]) == combination, axis=1)], incumbent=False)
+        local.believe(chosen[np.all(np.rint(chosen[:, dims]) == combination, axis=1)])
+        acquisition = GPAcquisition(local)
+        for d, option in zip(dims, combination):
+            acquisition = Pinned(acquisition, d, int(option))
+        moved = candidates[np.argsort(alpha, kind="stable")[:COVER_STARTS]].copy()
+        moved[:, dims] = combination
+        start = np.concatenate([models.X[rows], moved[self.constraints.feasible(moved)]])
+        points, values = self._candidates(acquisition, start, False, optimizer, rng, feasibility)
+        keep = np.isfinite(values)
+        return points[keep], values[keep], int(rows.sum())
 
     def _changed(self, point: np.ndarray, dims: list[int], k: int) -> np.ndarray:
         """`point` with k of its options of `dims` changed, to every other option of each, those that the known

@@ -130,6 +130,21 @@ class SurrogateChoice:
         self.fits.put(key, gp.hyperparameters)
         return gp
 
+    def local_gaussian_process(self, X: np.ndarray, successful: Sequence[Observation],
+                               descriptors: Mapping[int, np.ndarray], rows: np.ndarray) -> GaussianProcess:
+        """The GP of the untransformed merits of the successful experiments `rows` (a boolean mask) alone: one
+        combination of options (`strategies.gryffin`, where the ask runs it), its hyperparameters fitted to those
+        experiments, seeded by the campaign seed and the number of successful experiments. Fitted and conditioned on
+        FIT_MAX of them at most (`fit_subset`: the best and a seeded draw of the rest), so a long campaign on few
+        combinations does not pay n^3 for it."""
+        from .gaussian_process import GaussianProcess, fit_subset
+
+        y = self.raw_merits(successful)
+        seed = int(np.random.default_rng([self.seed, len(X), 5]).integers(2**62))
+        index = np.flatnonzero(rows)
+        index = index[fit_subset(y[index], seed)]
+        return GaussianProcess(self.space, X[index], y[index], seed, descriptors)
+
     def initial_design(self, levels: int, successes: int) -> bool:
         """Whether an ask's proposals are random feasible points (`GP_MIN_RESULTS`): the GP would make them (`gp`, or
         `portfolio` starting from it) and the `successes` successful experiments, fewer than INITIAL_DESIGN_MAX, have
