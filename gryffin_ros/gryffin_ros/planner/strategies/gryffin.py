@@ -412,7 +412,7 @@ class Planner(BasePlanner):
                 x = self._pick(candidates, alpha, observed, chosen, rng, diverse=False)
                 if within and i == 0 and np.array_equal(np.rint(x[dims]), np.rint(incumbent[dims])):
                     local = self._within(models, dims, incumbent, candidates, alpha, optimizer, rng, feasibility,
-                                         observed, chosen)
+                                         failed, chosen)
                     index = select(self.space, local[0], local[1], observed, chosen, diverse=False,
                                    dist_param=self.config.general.dist_param) if local is not None else None
                     if index is not None:
@@ -457,15 +457,16 @@ class Planner(BasePlanner):
 
     def _within(self, models: Surrogates, dims: list[int], incumbent: np.ndarray, candidates: np.ndarray,
                 alpha: np.ndarray, optimizer: AcquisitionOptimizer, rng: np.random.Generator,
-                feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray
+                feasibility: FeasibilityModel | None, failed: np.ndarray, chosen: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray, int] | None:
         """Candidates within the incumbent's combination of options of `dims`, by the expected improvement of a GP of
-        that combination's successful experiments alone (`SurrogateChoice.local_gaussian_process`; its failed and
-        pending ones believed as in the campaign's GP), optimized with those options pinned from its experiments and
-        the best `candidates` moved into it; their scores, and how many experiments the GP had. None with fewer than
-        WITHIN_LEAST of them. The GP over every combination pools a condition's effect across combinations (m_raft: its
-        length scale of the initiator's descriptor was 5, as if every initiator had one best temperature); one
-        combination's optimum can lie where the others' does not (benchmarks/README.md round thirty-two)."""
+        that combination's successful experiments alone (`SurrogateChoice.local_gaussian_process`; its `failed` and
+        `chosen` (pending) ones believed as in the campaign's GP), optimized with those options pinned from its
+        experiments and the best `candidates` moved into it (`_best_moved`); their scores, and how many experiments the
+        GP had. None with fewer than WITHIN_LEAST of them. The GP over every combination pools a condition's effect
+        across combinations (m_raft: its length scale of the initiator's descriptor was 5, as if every initiator had
+        one best temperature); one combination's optimum can lie where the others' does not (benchmarks/README.md
+        round thirty-two)."""
         combination = np.rint(incumbent[dims])
         rows = np.all(np.rint(models.X[:, dims]) == combination, axis=1)
         if rows.sum() < WITHIN_LEAST:
@@ -473,16 +474,12 @@ class Planner(BasePlanner):
         from ..acquisition.gp import GPAcquisition
 
         local = self.surrogate_choice.local_gaussian_process(models.X, models.successful, models.descriptors, rows)
-        failed = observed[np.array([o.failed for o in self.observations], dtype=bool)] if feasibility is not None \
-            else observed[:0]
         local.believe(failed[np.all(np.rint(failed[:, dims]) == combination, axis=1)], incumbent=False)
         local.believe(chosen[np.all(np.rint(chosen[:, dims]) == combination, axis=1)])
         acquisition = GPAcquisition(local)
         for d, option in zip(dims, combination):
             acquisition = Pinned(acquisition, d, int(option))
-        moved = candidates[np.argsort(alpha, kind="stable")[:COVER_STARTS]].copy()
-        moved[:, dims] = combination
-        start = np.concatenate([models.X[rows], moved[self.constraints.feasible(moved)]])
+        start = np.concatenate([models.X[rows], self._best_moved(candidates, alpha, dims, combination)])
         points, values = self._candidates(acquisition, start, False, optimizer, rng, feasibility)
         keep = np.isfinite(values)
         return points[keep], values[keep], int(rows.sum())
@@ -507,6 +504,13 @@ class Planner(BasePlanner):
             out += [(d, int(o)) for o in np.flatnonzero(self.space.option_tally(points, d) < COVER_TRIES)]
         return out
 
+    def _best_moved(self, candidates: np.ndarray, alpha: np.ndarray, dims: list[int], options) -> np.ndarray:
+        """The COVER_STARTS best `candidates` (by `alpha`) with their values of `dims` set to `options`, those the known
+        constraints allow: start points for an optimization under those options."""
+        moved = candidates[np.argsort(alpha, kind="stable")[:COVER_STARTS]].copy()
+        moved[:, dims] = options
+        return moved[self.constraints.feasible(moved)]
+
     def _covering_candidates(self, acquisition: AcquisitionFunction, under: list[tuple[int, int]],
                              candidates: np.ndarray, alpha: np.ndarray, optimizer: AcquisitionOptimizer,
                              rng: np.random.Generator, feasibility: FeasibilityModel | None
@@ -514,14 +518,11 @@ class Planner(BasePlanner):
         """For each under-tried (dim, option) of `under`: the COVER_STARTS best candidates with that option set (those
         still feasible) and the candidates that hold it, optimized with the option pinned; the results that kept it,
         scored."""
-        best = candidates[np.argsort(alpha, kind="stable")[:COVER_STARTS]]
         found, scores = [np.empty((0, self.space.dim))], [np.empty(0)]
         for d, option in under:
-            moved = best.copy()
-            moved[:, d] = option
             holding = np.flatnonzero(np.rint(candidates[:, d]) == option)
             holding = holding[np.argsort(alpha[holding], kind="stable")[:COVER_STARTS]]
-            start = np.concatenate([moved[self.constraints.feasible(moved)], candidates[holding]])
+            start = np.concatenate([self._best_moved(candidates, alpha, [d], [option]), candidates[holding]])
             if not len(start):  # no known feasible point holds it: the constraints rule it out here
                 continue
             points, values = self._candidates(Pinned(acquisition, d, option), start, False, optimizer, rng,
