@@ -468,14 +468,18 @@ class Planner(BasePlanner):
         one best temperature); one combination's optimum can lie where the others' does not (benchmarks/README.md
         round thirty-two)."""
         combination = np.rint(incumbent[dims])
-        rows = np.all(np.rint(models.X[:, dims]) == combination, axis=1)
+
+        def holding(points: np.ndarray) -> np.ndarray:  # which of `points` run the combination
+            return np.all(np.rint(points[:, dims]) == combination, axis=1)
+
+        rows = holding(models.X)
         if rows.sum() < WITHIN_LEAST:
             return None
         from ..acquisition.gp import GPAcquisition
 
         local = self.surrogate_choice.local_gaussian_process(models.X, models.successful, models.descriptors, rows)
-        local.believe(failed[np.all(np.rint(failed[:, dims]) == combination, axis=1)], incumbent=False)
-        local.believe(chosen[np.all(np.rint(chosen[:, dims]) == combination, axis=1)])
+        local.believe(failed[holding(failed)], incumbent=False)
+        local.believe(chosen[holding(chosen)])
         acquisition = GPAcquisition(local)
         for d, option in zip(dims, combination):
             acquisition = Pinned(acquisition, d, int(option))
