@@ -73,6 +73,8 @@ COVER_TRIES = 2
 COVER_STARTS = 32
 # The fewest successful experiments on the incumbent's combination of options for a GP of their own (`Planner._within`).
 WITHIN_LEAST = 4
+# An experiment this close to a bound of a continuous condition (internal units, the range being [0, 1]) sits on it.
+BOUND_NEAR = 0.02
 
 
 @dataclass
@@ -265,16 +267,16 @@ class Planner(BasePlanner):
         incumbent = X[int(np.argmin(merits))]
         start, exhaustive = self.start_points(rng, incumbent, X)
         if gp is not None:
-            self._after_stall(gp, meta)
+            stalled = self._after_stall(gp, meta)
             points, notes = self._propose_gp(n, rng, gp, start, exhaustive, feasibility, observed, chosen, incumbent,
-                                             models)
+                                             models, stalled)
             meta.update(notes)
             return points, [None] * n, meta
         return (*self._propose_kde(n, rng, density, start, exhaustive, feasibility, observed, chosen), meta)
 
-    def _after_stall(self, gp: GaussianProcess, meta: dict[str, Any]) -> None:
+    def _after_stall(self, gp: GaussianProcess, meta: dict[str, Any]) -> bool:
         """When the campaign has stalled (`stall`), the GP of this ask predicts what has not been tried at the
-        results' mean; the proposals' meta say so."""
+        results' mean; the proposals' meta say so. Whether it has."""
         _, values = self.successful_values()
         merits = np.full(len(self.observations), np.nan)
         merits[[not o.failed for o in self.observations]] = self.merits_of_values(values, transform=False)
@@ -284,6 +286,7 @@ class Planner(BasePlanner):
             gp.at_results_mean()
             meta["stalled"] = (f"the last {STALL_WINDOW} experiments improved the best result by {100 * share:.2g} % "
                                "of the results' range: untried regions predicted at the results' mean")
+        return share is not None
 
     def _propose_kde(self, n: int, rng: np.random.Generator, density: KernelDensity, start: np.ndarray,
                      exhaustive: bool, feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray
@@ -340,7 +343,8 @@ class Planner(BasePlanner):
 
     def _propose_gp(self, n: int, rng: np.random.Generator, gp: GaussianProcess, start: np.ndarray, exhaustive: bool,
                     feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray,
-                    incumbent: np.ndarray, models: Surrogates) -> tuple[np.ndarray, dict[str, str]]:
+                    incumbent: np.ndarray, models: Surrogates, stalled: bool = False
+                    ) -> tuple[np.ndarray, dict[str, str]]:
         """n points by the GP's expected improvement; failed and pending experiments and the batch's earlier proposals
         enter the GP as believed results (kriging believer), so they are not proposed again and a batch spreads out
         without Gryffin's strategies. The acquisition is optimized once per ask; each further point of a batch is the
@@ -348,7 +352,9 @@ class Planner(BasePlanner):
         been run fewer than COVER_TRIES times, a point is the best candidate that holds one (`under_tried`); else,
         when the campaign has settled on one combination of those parameters' options (`settled`), the first point is
         the best result's conditions with one option changed, to a combination not run yet where one is left, else
-        with two (`_swaps`). When the first point of an ask after an odd number of experiments runs the best result's
+        with two (`_swaps`); else, on a stalled ask whose best result and most of the last experiments sit on a bound
+        of a continuous condition (`_on_bound`), the first point runs it in the other half of its range
+        (`_released`). When the first point of an ask after an odd number of experiments runs the best result's
         combination of those options anyway, where in it is decided by a GP of that combination's own experiments
         (`_within`). The second value: the proposals' meta entries that say so."""
         # failed experiments enter as believed results too: the GP learns nothing of the objective from them, so
@@ -373,6 +379,9 @@ class Planner(BasePlanner):
                   and len(observed) % 2 == 1)
         if combination is not None and not under:  # a settled campaign: the first point runs another combination
             swaps = self._swaps(acquisition, dims, combination, incumbent, optimizer, rng, feasibility, asked)
+        bound = self._on_bound(incumbent, observed) if stalled and not under and not exhaustive else None
+        released = self._released(acquisition, start, candidates, alpha, *bound, optimizer, rng, feasibility) \
+            if bound is not None else None
         if under and not exhaustive:
             pinned, pinned_alpha = self._covering_candidates(acquisition, under, candidates, alpha, optimizer, rng,
                                                              feasibility)
@@ -408,6 +417,15 @@ class Planner(BasePlanner):
                     notes["settled"] = (f"{SETTLE_LEAST} or more of the last {STALL_WINDOW} experiments ran {held}: "
                                         "this one runs the best result's conditions with one option changed (two "
                                         "when every combination one option away has run)")
+            if x is None and released is not None and len(released[0]) and i == 0:
+                index = select(self.space, *released, observed, chosen, diverse=False,
+                               dist_param=self.config.general.dist_param)
+                if index is not None:
+                    x = released[0][index]
+                    d, side = bound
+                    notes["off_bound"] = (f"{self.space.names[d]} sat at its {'upper' if side else 'lower'} bound in "
+                                          f"{SETTLE_LEAST} or more of the last {STALL_WINDOW} experiments and the "
+                                          "campaign stalled: this one runs it in the other half of its range")
             if x is None:
                 x = self._pick(candidates, alpha, observed, chosen, rng, diverse=False)
                 if within and i == 0 and np.array_equal(np.rint(x[dims]), np.rint(incumbent[dims])):
@@ -487,6 +505,45 @@ class Planner(BasePlanner):
         points, values = self._candidates(acquisition, start, False, optimizer, rng, feasibility)
         keep = np.isfinite(values)
         return points[keep], values[keep], int(rows.sum())
+
+    def _on_bound(self, incumbent: np.ndarray, observed: np.ndarray) -> tuple[int, float] | None:
+        """(dim, bound: 0 or 1) of the continuous condition that the best result sits on a bound of (within
+        BOUND_NEAR) and SETTLE_LEAST or more of the last STALL_WINDOW experiments sit on too, the one most of them do;
+        None if none."""
+        recent = observed[-STALL_WINDOW:]
+        found, most = None, 0
+        for d in self.space.cont_idx:
+            if self.space.periodic[d]:
+                continue
+            for side in (0.0, 1.0):
+                if abs(incumbent[d] - side) > BOUND_NEAR:
+                    continue
+                count = int((np.abs(recent[:, d] - side) <= BOUND_NEAR).sum())
+                if count >= SETTLE_LEAST and count > most:
+                    found, most = (int(d), side), count
+        return found
+
+    def _released(self, acquisition: AcquisitionFunction, start: np.ndarray, candidates: np.ndarray,
+                  alpha: np.ndarray, d: int, side: float, optimizer: AcquisitionOptimizer, rng: np.random.Generator,
+                  feasibility: FeasibilityModel | None) -> tuple[np.ndarray, np.ndarray]:
+        """Candidates whose condition d lies in the half of its range away from the bound `side` (0 or 1): the start
+        points there and the COVER_STARTS best `candidates` with d drawn in it, optimized (d held in that half), those
+        the known constraints allow, scored."""
+        low, high = (0.0, 0.5) if side else (0.5, 1.0)
+        moved = candidates[np.argsort(alpha, kind="stable")[:COVER_STARTS]].copy()
+        moved[:, d] = rng.uniform(low, high, len(moved))
+        inside = start[(start[:, d] >= low) & (start[:, d] <= high)]
+        begin = np.concatenate([inside, moved[self.constraints.feasible(moved)]])
+        if not len(begin):
+            return begin, np.empty(0)
+        points, _ = self._candidates(acquisition, begin, False, optimizer, rng, feasibility)
+        points[:, d] = np.clip(points[:, d], low, high)
+        points = points[self.constraints.feasible(points)]
+        if not len(points):
+            return points, np.empty(0)
+        points, values = self._candidates(acquisition, points, True, optimizer, rng, feasibility)
+        keep = np.isfinite(values)
+        return points[keep], values[keep]
 
     def _changed(self, point: np.ndarray, dims: list[int], k: int) -> np.ndarray:
         """`point` with k of its options of `dims` changed, to every other option of each, those that the known
