@@ -380,8 +380,6 @@ class Planner(BasePlanner):
         if combination is not None and not under:  # a settled campaign: the first point runs another combination
             swaps = self._swaps(acquisition, dims, combination, incumbent, optimizer, rng, feasibility, asked)
         bound = self._on_bound(incumbent, observed) if stalled and not under and not exhaustive else None
-        released = self._released(acquisition, start, candidates, alpha, *bound, optimizer, rng, feasibility) \
-            if bound is not None else None
         if under and not exhaustive:
             pinned, pinned_alpha = self._covering_candidates(acquisition, under, candidates, alpha, optimizer, rng,
                                                              feasibility)
@@ -417,9 +415,10 @@ class Planner(BasePlanner):
                     notes["settled"] = (f"{SETTLE_LEAST} or more of the last {STALL_WINDOW} experiments ran {held}: "
                                         "this one runs the best result's conditions with one option changed (two "
                                         "when every combination one option away has run)")
-            if x is None and released is not None and len(released[0]) and i == 0:
+            if x is None and bound is not None and i == 0:  # optimized only when no settled swap took the ask
+                released = self._released(acquisition, start, candidates, alpha, *bound, optimizer, rng, feasibility)
                 index = select(self.space, *released, observed, chosen, diverse=False,
-                               dist_param=self.config.general.dist_param)
+                               dist_param=self.config.general.dist_param) if len(released[0]) else None
                 if index is not None:
                     x = released[0][index]
                     d, side = bound
