@@ -529,10 +529,9 @@ class Planner(BasePlanner):
         points there and the COVER_STARTS best `candidates` with d drawn in it, optimized (d held in that half), those
         the known constraints allow, scored."""
         low, high = (0.0, 0.5) if side else (0.5, 1.0)
-        moved = candidates[np.argsort(alpha, kind="stable")[:COVER_STARTS]].copy()
-        moved[:, d] = rng.uniform(low, high, len(moved))
+        drawn = rng.uniform(low, high, (min(COVER_STARTS, len(candidates)), 1))  # one value of d per moved candidate
         inside = start[(start[:, d] >= low) & (start[:, d] <= high)]
-        begin = np.concatenate([inside, moved[self.constraints.feasible(moved)]])
+        begin = np.concatenate([inside, self._best_moved(candidates, alpha, [d], drawn)])
         if not len(begin):
             return begin, np.empty(0)
         points, _ = self._candidates(acquisition, begin, False, optimizer, rng, feasibility)
