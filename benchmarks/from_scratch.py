@@ -38,7 +38,7 @@ import argparse
 import os
 import statistics
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 from multiprocessing import Pool
 from pathlib import Path
 
@@ -84,11 +84,13 @@ def hidden_failure(task, x: list) -> bool:
     return bool(HIDDEN_RULES[task.name](task, x))
 
 
-def campaign(task, seed: int, budget: int, fails: Callable[[int, list], bool]) -> tuple[int, int, float]:
-    """One campaign of a harness task from the planner's first proposal (the default config, the task's constraint as
-    the known constraint); `fails(experiment, x)` says whether experiment number `experiment` (from 1) at the harness
-    point x fails (reported as None) -> (failed experiments, failed in the budget's second half, best successful
-    value)."""
+def steps(task, seed: int, budget: int, fails: Callable[[int, list], bool], initial: Sequence[list] = ()
+          ) -> Iterator[tuple[int, list, float | None, dict]]:
+    """One campaign of a harness task, experiment by experiment, with the default planner (the default config, the
+    task's constraint as the known constraint): the points of `initial` told first (the peer harness's initial design;
+    they count toward `budget`), then the planner's proposals; `fails(experiment, x)` says whether experiment number
+    `experiment` (from 1) at the harness point x fails (reported as None) -> (experiment, harness point, its result or
+    None, the proposal's meta: {} for an initial point)."""
     import torch
 
     from benchmarks.peers.gryffin_ros_peer import config, from_planner, option_names_of, to_planner
@@ -98,16 +100,26 @@ def campaign(task, seed: int, budget: int, fails: Callable[[int, list], bool]) -
     index = {n: {o: i for i, o in enumerate(options)} for n, options in names.items()}
     planner = Planner(config(task, None, False, names), seed=seed,
                       known_constraints=lambda params: task.feasible(from_planner(task, params, index)))
-    failed, late, best = 0, 0, float("inf")
     for experiment in range(1, budget + 1):
-        (proposal,) = planner.ask()
-        x = from_planner(task, proposal.params, index)
-        failing = fails(experiment, x)
-        failed += failing
-        late += failing and experiment > budget // 2
-        y = None if failing else float(task.objective(x))
+        if experiment <= len(initial):
+            x, meta, told = list(initial[experiment - 1]), {}, {}
+        else:
+            (proposal,) = planner.ask()
+            x, meta = from_planner(task, proposal.params, index), proposal.meta
+            told = {"experiment_id": proposal.experiment_id}
+        y = None if fails(experiment, x) else float(task.objective(x))
+        planner.tell({**to_planner(task, x, names), "y": y, **told})
+        yield experiment, x, y, meta
+
+
+def campaign(task, seed: int, budget: int, fails: Callable[[int, list], bool]) -> tuple[int, int, float]:
+    """One campaign of a harness task from the planner's first proposal (`steps`) -> (failed experiments, failed in
+    the budget's second half, best successful value)."""
+    failed, late, best = 0, 0, float("inf")
+    for experiment, _, y, _ in steps(task, seed, budget, fails):
+        failed += y is None
+        late += y is None and experiment > budget // 2
         best = best if y is None else min(best, y)
-        planner.tell({**to_planner(task, x, names), "y": y, "experiment_id": proposal.experiment_id})
     return failed, late, best
 
 

@@ -1,0 +1,55 @@
+"""benchmarks.trace: one campaign of a portfolio task, experiment by experiment (benchmarks/trace.py)."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from benchmarks import from_scratch, portfolio_tasks, trace
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_a_point_is_described_by_its_option_names_and_conditions():
+    task = portfolio_tasks.TASKS["m_oxidation"]()
+    x = [task.coppers.index("CuOTf"), task.nitroxyls.index("ABNO"), 1,
+         portfolio_tasks.OX_ATMOSPHERES.index("air"), 45.0, 7.6, 9.0]
+    assert trace.describe(task, x) == "copper=CuOTf nitroxyl=ABNO bpy=1 atmosphere=air T=45 t=7.6 loading=9"
+
+
+def test_the_harness_start_tells_the_task_s_initial_points_first_then_prints_the_planner_s_proposals():
+    task = portfolio_tasks.TASKS["m_oxidation"]()
+    initial = task.initial_points(2)
+    out = list(trace.lines(task, 2, budget=len(initial) + 1))
+    assert len(out) == len(initial) + 2
+    for k, (line, x) in enumerate(zip(out, initial), 1):
+        assert line.split()[:2] == [str(k), "initial"]
+        assert trace.describe(task, x) in line
+    proposal = out[len(initial)].split()
+    assert proposal[0] == str(len(initial) + 1) and proposal[1] != "initial"
+    results = [float(line.split("  ")[-1]) for line in out[:len(initial)]]
+    best = float(out[-1].split(",")[0].split()[1])
+    assert best <= min(results)  # the summary's best is at least as good as every initial result
+    regret = float(out[-1].split("regret")[1])
+    # both printed to 4 decimals: each off by at most 5e-5
+    assert regret == pytest.approx(best - from_scratch.REFERENCES["m_oxidation"], abs=1e-4)
+
+
+def test_hidden_failures_are_refused_for_a_task_without_them_and_an_unknown_task_is_named():
+    command = [sys.executable, "-m", "benchmarks.trace"]
+    hidden = subprocess.run(command + ["--task", "m_photoredox", "--hidden"], cwd=ROOT, capture_output=True,
+                            text=True)
+    assert hidden.returncode != 0 and "--hidden is defined for" in hidden.stderr
+    unknown = subprocess.run(command + ["--task", "m_nothing"], cwd=ROOT, capture_output=True, text=True)
+    assert unknown.returncode != 0 and "m_nothing" in unknown.stderr
+
+
+def test_a_campaign_from_scratch_starts_with_the_planner_s_first_proposal():
+    budget = 3
+    task = portfolio_tasks.TASKS["m_oxidation"]()
+    out = list(trace.lines(task, 0, scratch=True, hidden=True, budget=budget))
+    assert len(out) == budget + 1
+    for k, line in enumerate(out[:-1], 1):
+        assert line.split()[0] == str(k) and line.split()[1] != "initial"
+    assert out[-1].startswith("best ")
