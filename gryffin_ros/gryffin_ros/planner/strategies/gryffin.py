@@ -343,7 +343,7 @@ class Planner(BasePlanner):
 
     def _propose_gp(self, n: int, rng: np.random.Generator, gp: GaussianProcess, start: np.ndarray, exhaustive: bool,
                     feasibility: FeasibilityModel | None, observed: np.ndarray, chosen: np.ndarray,
-                    incumbent: np.ndarray, models: Surrogates, stalled: bool = False
+                    incumbent: np.ndarray, models: Surrogates, stalled: bool
                     ) -> tuple[np.ndarray, dict[str, str]]:
         """n points by the GP's expected improvement; failed and pending experiments and the batch's earlier proposals
         enter the GP as believed results (kriging believer), so they are not proposed again and a batch spreads out
