@@ -41,6 +41,7 @@ import sys
 from collections.abc import Callable, Iterator, Sequence
 from multiprocessing import Pool
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
 # the harness's `problems`, which the tasks build on (as in portfolio.py)
@@ -85,12 +86,13 @@ def hidden_failure(task, x: list) -> bool:
 
 
 def steps(task, seed: int, budget: int, fails: Callable[[int, list], bool], initial: Sequence[list] = ()
-          ) -> Iterator[tuple[int, list, float | None, dict]]:
+          ) -> Iterator[tuple[int, list, float | None, dict, Any]]:
     """One campaign of a harness task, experiment by experiment, with the default planner (the default config, the
     task's constraint as the known constraint): the points of `initial` told first (the peer harness's initial design;
     they count toward `budget`), then the planner's proposals; `fails(experiment, x)` says whether experiment number
     `experiment` (from 1) at the harness point x fails (reported as None) -> (experiment, harness point, its result or
-    None, the proposal's meta: {} for an initial point)."""
+    None, the proposal's meta: {} for an initial point, the planner after that result: `trace --gp-after` inspects
+    it)."""
     import torch
 
     from benchmarks.peers.gryffin_ros_peer import config, from_planner, option_names_of, to_planner
@@ -109,14 +111,14 @@ def steps(task, seed: int, budget: int, fails: Callable[[int, list], bool], init
             told = {"experiment_id": proposal.experiment_id}
         y = None if fails(experiment, x) else float(task.objective(x))
         planner.tell({**to_planner(task, x, names), "y": y, **told})
-        yield experiment, x, y, meta
+        yield experiment, x, y, meta, planner
 
 
 def campaign(task, seed: int, budget: int, fails: Callable[[int, list], bool]) -> tuple[int, int, float]:
     """One campaign of a harness task from the planner's first proposal (`steps`) -> (failed experiments, failed in
     the budget's second half, best successful value)."""
     failed, late, best = 0, 0, float("inf")
-    for experiment, _, y, _ in steps(task, seed, budget, fails):
+    for experiment, _, y, _, _ in steps(task, seed, budget, fails):
         failed += y is None
         late += y is None and experiment > budget // 2
         best = best if y is None else min(best, y)

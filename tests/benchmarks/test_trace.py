@@ -53,3 +53,41 @@ def test_a_campaign_from_scratch_starts_with_the_planner_s_first_proposal():
     for k, line in enumerate(out[:-1], 1):
         assert line.split()[0] == str(k) and line.split()[1] != "initial"
     assert out[-1].startswith("best ")
+
+
+def test_the_gp_after_k_experiments_names_each_input_s_length_scale_and_scores_the_best_result_and_changes():
+    """--gp-after: the GP the campaign's next ask builds, each Matern term's length scales by input name (m_oxidation:
+    three conditions, two descriptor columns of each salt and nitroxyl, the bipyridine level; the atmosphere, without
+    descriptors, in the categorical kernel), then the best result and an --at point (the best result with bipyridine
+    changed), each with its true result."""
+    task = portfolio_tasks.TASKS["m_oxidation"]()
+    after = len(task.initial_points(2)) + 3
+    out = list(trace.gp_lines(task, 2, after, at=["bpy=1"]))
+    assert out[0].startswith(f"GP after {after} experiments")
+    terms = [line for line in out if line.strip().startswith("Matern term")]
+    assert terms
+    inputs = ["T", "t", "loading", "copper[0]", "copper[1]", "nitroxyl[0]", "nitroxyl[1]", "bpy"]
+    for line in terms:
+        pairs = line.split(": ", 1)[1].split(", ")
+        assert [p.rsplit(" ", 1)[0] for p in pairs] == inputs
+        assert all(1e-3 * (1 - 1e-6) <= float(p.rsplit(" ", 1)[1]) <= 20 * (1 + 1e-3) for p in pairs)
+    assert any("categorical kernel" in line and "atmosphere" in line for line in out)
+    best, changed = out[-2], out[-1]
+    assert best.startswith("best result: ") and changed.startswith("bpy=1: ")
+    results = [y for _, _, y, _, _ in from_scratch.steps(task, 2, after, lambda *_: False, task.initial_points(2))]
+    # printed to 4 decimals
+    assert float(best.rsplit("true result ", 1)[1]) == pytest.approx(min(results), abs=1e-4)
+    best_point, changed_point = (line.split(": ")[1].split() for line in (best, changed))
+    assert [p for p in changed_point if not p.startswith("bpy=")] == [p for p in best_point if not p.startswith("bpy=")]
+    assert "bpy=1" in changed_point
+    for line in (best, changed):
+        assert float(line.split("+- ")[1].split()[0]) > 0  # a posterior standard deviation
+
+
+def test_an_at_point_naming_an_unknown_parameter_or_option_is_refused_with_the_known_ones():
+    task = portfolio_tasks.TASKS["m_oxidation"]()
+    after = len(task.initial_points(0)) + 1
+    with pytest.raises(ValueError, match="unknown parameter 'bipy'.*bpy"):
+        list(trace.gp_lines(task, 0, after, at=["bipy=1"]))
+    with pytest.raises(ValueError, match="copper has no option 'CuCl'.*CuOTf"):
+        list(trace.gp_lines(task, 0, after, at=["copper=CuCl"]))
