@@ -11,8 +11,9 @@ experiment for experiment. With --scratch it is `python -m benchmarks.from_scrat
 --hidden, under its hidden failures). The last line: the best result, and the plain regret (best - reference,
 `from_scratch.REFERENCES`) where the task has a reference.
 
-With --gp-after K the campaign stops after K experiments and prints the GP that the next ask builds (whichever
-surrogate the portfolio then picks; before the stall rule's shift of its mean): each Matern term's output scale and
+With --gp-after K the campaign stops after K experiments and prints the GP that the next ask fits to the successful
+results (whichever surrogate the portfolio then picks; the ask then also believes failed experiments at its incumbent
+and shifts its mean when the campaign has stalled, which this does not show): each Matern term's output scale and
 its length scales by input (inputs in [0, 1]: a length scale far below the spacing of a parameter's levels makes each
 level its own function), the noise, and for the best result so far and each --at point (the best result's point with
 the given parameters changed, option names for categorical parameters) the posterior mean +- standard deviation and
@@ -140,7 +141,8 @@ def gp_lines(task, seed: int, after: int, at: Sequence[str] = (), scratch: bool 
         with torch.no_grad():
             mean, sigma = (float(v) for v in gp.posterior.mean_and_sigma(gp.features.of(X)))
         x = from_planner(task, params, index)
-        truth = f"{task.objective(x):.4f}" if task.feasible(x) else "not allowed by the known constraints"
+        truth = ("not allowed by the known constraints" if not task.feasible(x)
+                 else "failed (hidden)" if hidden and hidden_failure(task, x) else f"{task.objective(x):.4f}")
         yield (f"{label}: {describe(task, x)}: mean {mean:.3f} +- {sigma:.3f} (best {gp.posterior.best:.3f}), "
                f"log EI {-float(acquisition.evaluate(X)[0]):.2f}, true result {truth}")
 

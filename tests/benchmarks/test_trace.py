@@ -91,3 +91,13 @@ def test_an_at_point_naming_an_unknown_parameter_or_option_is_refused_with_the_k
         list(trace.gp_lines(task, 0, after, at=["bipy=1"]))
     with pytest.raises(ValueError, match="copper has no option 'CuCl'.*CuOTf"):
         list(trace.gp_lines(task, 0, after, at=["copper=CuCl"]))
+
+
+def test_an_at_point_that_the_hidden_failures_fail_says_so_instead_of_a_result():
+    """m_oxidation's hidden failures fail every experiment with AZADO: with --hidden, such a point's true result is
+    a failure, not the objective's value."""
+    task = portfolio_tasks.TASKS["m_oxidation"]()
+    out = list(trace.gp_lines(task, 0, 8, at=["nitroxyl=AZADO", "nitroxyl=ABNO"], scratch=True, hidden=True))
+    azado, abno = out[-2], out[-1]
+    assert azado.startswith("nitroxyl=AZADO: ") and azado.endswith("true result failed (hidden)")
+    assert abno.startswith("nitroxyl=ABNO: ") and "failed" not in abno
