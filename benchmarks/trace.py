@@ -108,8 +108,7 @@ def gp_lines(task, seed: int, after: int, at: Sequence[str] = (), scratch: bool 
         if not isinstance(kernel, MaternKernel):
             continue
         # its output scale: that of the innermost scale kernel around it (BoTorch's mixed GP nests them)
-        scaled = [k for k, m in modules.items() if isinstance(m, ScaleKernel) and path.startswith(k + ".")
-                  or (k == "" and isinstance(m, ScaleKernel))]
+        scaled = [k for k, m in modules.items() if isinstance(m, ScaleKernel) and (k == "" or path.startswith(k + "."))]
         outputscale = modules[max(scaled, key=len)].outputscale.detach().item() if scaled else 1.0
         dims = (kernel.active_dims.tolist() if kernel.active_dims is not None
                 else [i for i in range(gp.features.dim) if i not in gp.features.cat_dims])
@@ -133,7 +132,11 @@ def gp_lines(task, seed: int, after: int, at: Sequence[str] = (), scratch: bool 
             if kind == "option" and value not in option_names[name]:
                 raise ValueError(f"--at {spec!r}: {name} has no option {value!r}; its options: "
                                  f"{', '.join(option_names[name])}")
-            params[name] = value if kind == "option" else (int(value) if kind == "int" else float(value))
+            try:
+                params[name] = value if kind == "option" else (int(value) if kind == "int" else float(value))
+            except ValueError:
+                raise ValueError(f"--at {spec!r}: {name} takes {'an integer' if kind == 'int' else 'a number'}, "
+                                 f"not {value!r}") from None
         points.append((spec, params))
     acquisition = GPAcquisition(gp)
     for label, params in points:
@@ -167,6 +170,8 @@ def main() -> None:
         parser.error("--budget must be at least 1")
     if args.at and args.gp_after is None:
         parser.error("--at needs --gp-after")
+    if args.budget is not None and args.gp_after is not None:
+        parser.error("--budget and --gp-after both end the campaign: give one")
     task = portfolio_tasks.TASKS[args.task]()
     if args.gp_after is not None:
         if args.gp_after < 2:

@@ -91,6 +91,8 @@ def test_an_at_point_naming_an_unknown_parameter_or_option_is_refused_with_the_k
         list(trace.gp_lines(task, 0, after, at=["bipy=1"]))
     with pytest.raises(ValueError, match="copper has no option 'CuCl'.*CuOTf"):
         list(trace.gp_lines(task, 0, after, at=["copper=CuCl"]))
+    with pytest.raises(ValueError, match="bpy takes an integer, not 'one'"):
+        list(trace.gp_lines(task, 0, after, at=["bpy=one"]))
 
 
 def test_an_at_point_that_the_hidden_failures_fail_says_so_instead_of_a_result():
