@@ -53,12 +53,18 @@ def describe(task, x: list) -> str:
     return " ".join(out)
 
 
+def campaign(task, seed: int, budget: int, scratch: bool, hidden: bool):
+    """-> (the initial points told first: none with `scratch`, `from_scratch.steps` of the campaign, under the hidden
+    failures with `hidden`)."""
+    initial = [] if scratch else task.initial_points(seed)
+    return initial, steps(task, seed, budget, lambda _, x: hidden and hidden_failure(task, x), initial)
+
+
 def lines(task, seed: int, scratch: bool = False, hidden: bool = False, budget: int | None = None):
     """The campaign's lines as printed (see the module's docstring), the summary last."""
-    initial = [] if scratch else task.initial_points(seed)
+    initial, experiments = campaign(task, seed, budget or task.budget, scratch, hidden)
     best = math.inf
-    for experiment, x, y, meta, _ in steps(task, seed, budget or task.budget,
-                                           lambda _, x: hidden and hidden_failure(task, x), initial):
+    for experiment, x, y, meta, _ in experiments:
         source = "initial" if experiment <= len(initial) else meta.get("surrogate", "")
         rules = " ".join(rule for rule in RULES if rule in meta)
         result = "failed" if y is None else f"{y:.4f}"
@@ -94,9 +100,8 @@ def gp_lines(task, seed: int, after: int, at: Sequence[str] = (), scratch: bool 
     from benchmarks.peers.gryffin_ros_peer import from_planner, option_names_of
     from gryffin_ros.planner.acquisition.gp import GPAcquisition
 
-    initial = [] if scratch else task.initial_points(seed)
-    *_, planner = collections.deque(steps(task, seed, after, lambda _, x: hidden and hidden_failure(task, x),
-                                          initial), maxlen=1)[0]  # the last step: the planner after `after` results
+    # the last step's planner: the one after `after` results
+    *_, planner = collections.deque(campaign(task, seed, after, scratch, hidden)[1], maxlen=1)[0]
     models = planner.surrogates()
     if models.density is None or len(models.successful) < 2:
         raise ValueError(f"after {after} experiments fewer than 2 have succeeded: no GP to show")
